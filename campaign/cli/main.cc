@@ -1,0 +1,53 @@
+// The `capsim` executable: a thin dispatcher over the sub-commands in commands.h.
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "campaign/cli/commands.h"
+#include "capsim/version.h"
+
+namespace {
+
+void print_usage() {
+  std::printf(
+      "capsim %s (%s): elastic capsules in simple shear flow (FEM membrane + boundary integrals)\n\n"
+      "usage:\n"
+      "  capsim run CASE.toml [--set key=value]... [--out DIR] [--threads N] [--resume] [--json]\n"
+      "  capsim campaign run CAMPAIGN.toml --db FILE [--jobs J] [--threads-per-job T] [--dry-run]\n"
+      "  capsim campaign status --db FILE\n"
+      "  capsim query table1|cases|sql ... --db FILE [--format md|csv|json]\n"
+      "  capsim bench kernel [--json]\n"
+      "  capsim --version\n",
+      capsim::kVersion, capsim::kGitCommit);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    print_usage();
+    return capsim::cli::kExitBadInput;
+  }
+  const std::string cmd = argv[1];
+  const std::vector<std::string> rest(argv + 2, argv + argc);
+  if (cmd == "--version" || cmd == "version") {
+    std::printf("capsim %s (commit %s)\n", capsim::kVersion, capsim::kGitCommit);
+    return 0;
+  }
+  if (cmd == "--help" || cmd == "-h" || cmd == "help") {
+    print_usage();
+    return 0;
+  }
+  try {
+    if (cmd == "run") return capsim::cli::run_command(rest);
+    if (cmd == "campaign") return capsim::cli::campaign_command(rest);
+    if (cmd == "query") return capsim::cli::query_command(rest);
+    if (cmd == "bench") return capsim::cli::bench_command(rest);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "capsim: error: %s\n", e.what());
+    return 1;
+  }
+  std::fprintf(stderr, "capsim: unknown command '%s' (see capsim --help)\n", cmd.c_str());
+  return capsim::cli::kExitBadInput;
+}

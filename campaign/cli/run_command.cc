@@ -1,0 +1,11 @@
+// Placeholder until the run sub-command lands; replaced by its real implementation.
+#include <cstdio>
+
+#include "campaign/cli/commands.h"
+
+namespace capsim::cli {
+int run_command(const std::vector<std::string>&) {
+  std::fprintf(stderr, "capsim: 'run' is not available in this build yet\n");
+  return kExitBadInput;
+}
+}  // namespace capsim::cli

@@ -1,0 +1,86 @@
+#pragma once
+/// @file
+/// @brief Closed P2 surface meshes of the capsule: a subdivided icosahedron on the unit sphere, mapped to a
+/// spheroid of revolution about x1 with semi-axes (a, b, b), a/b = r, a b² = 1 (DESIGN.md §1–§2).
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace capsim::mesh {
+
+/// @brief Vertex of the underlying flat triangulation, or mid-side node of a P2 element.
+enum class NodeKind : std::uint8_t { Vertex = 0, MidSide = 1 };
+
+/// @brief How sphere nodes are placed on the spheroid.
+enum class SpheroidMap {
+  /// x = (a X1, b X2, b X3): simple, but at a/b = 2 the equatorial elements are stretched twice as much
+  /// along meridians as around them.
+  AxisScaling,
+  /// Nodes moved along meridians so that meridional arc length is proportional to the sphere's polar
+  /// angle: uniform spacing along meridians, anisotropy only at the equator (≈1.5 at a/b = 2).
+  EqualArcLength,
+  /// Nodes moved along meridians so that the map sphere → spheroid is conformal (isothermal latitude):
+  /// element angles are those of the sphere mesh up to the discretisation; sizes vary smoothly instead.
+  Conformal,
+};
+
+/// @brief A closed surface of P2 triangles.
+struct SurfaceMesh {
+  /// Node coordinates, one column per node.
+  Eigen::Matrix3Xd nodes;
+  /// Element → 6 node indices (vertices 0,1,2; mid-sides 3: 0–1, 4: 1–2, 5: 2–0). Counter-clockwise seen
+  /// from outside, so (x1 − x0) × (x2 − x0) points outward.
+  std::vector<std::array<int, 6>> elements;
+  /// Vertex or mid-side, per node.
+  std::vector<NodeKind> kind;
+  /// Node → elements containing it, compressed: elements of node i are
+  /// node_elements[node_element_offsets[i] .. node_element_offsets[i + 1]).
+  std::vector<int> node_element_offsets;
+  std::vector<int> node_elements;
+  /// Mirror image of each node under x3 → −x3 (itself when x3 = 0); mirror_node[mirror_node[i]] == i.
+  std::vector<int> mirror_node;
+  /// Subdivision level of the icosahedron (0..6).
+  int level = 0;
+
+  [[nodiscard]] int num_nodes() const { return static_cast<int>(nodes.cols()); }
+  [[nodiscard]] int num_elements() const { return static_cast<int>(elements.size()); }
+};
+
+/// @brief Unit sphere: icosahedron subdivided `level` times (0..6), 20·4^level P2 elements,
+/// 10·4^level + 2 vertices and 30·4^level mid-side nodes (40·4^level + 2 nodes), all on the sphere.
+/// @throws std::invalid_argument if level is outside 0..6.
+SurfaceMesh make_sphere_mesh(int level);
+
+/// @brief Semi-axes (a, b) of the spheroid with a/b = aspect_ratio and a b² = 1 (ℓ = 1).
+/// @throws std::invalid_argument if aspect_ratio ≤ 0 or not finite.
+std::array<double, 2> spheroid_semi_axes(double aspect_ratio);
+
+/// @brief The capsule's reference mesh: the sphere mesh of `level` mapped to the spheroid a/b =
+/// aspect_ratio (revolution axis x1) with the given map. aspect_ratio = 1 gives the unit sphere.
+SurfaceMesh make_capsule_mesh(int level, double aspect_ratio, SpheroidMap map = SpheroidMap::Conformal);
+
+/// @brief Element-shape statistics of the flat vertex triangles.
+struct MeshQuality {
+  double min_angle_deg = 0;           ///< smallest interior angle over all elements
+  double max_edge_ratio = 0;          ///< worst longest/shortest edge within one element
+  double mean_edge_ratio = 0;         ///< mean of longest/shortest edge over elements
+  double min_edge = 0, max_edge = 0;  ///< global extreme edge lengths (h_min, h_max)
+  double size_ratio = 0;              ///< max over min element area
+};
+
+/// @brief Quality statistics of a mesh.
+MeshQuality mesh_quality(const SurfaceMesh& mesh);
+
+/// @brief Smallest distance between two nodes of the same element, on the current positions x
+/// (the h of the explicit stability limit dt ≲ c Ca h).
+double min_node_spacing(const SurfaceMesh& mesh, const Eigen::Matrix3Xd& x);
+
+/// @brief Parse a spheroid-map name ("conformal" | "equal-arc-length" | "axis-scaling").
+/// @throws std::invalid_argument naming the accepted values.
+SpheroidMap parse_spheroid_map(const std::string& name);
+
+}  // namespace capsim::mesh

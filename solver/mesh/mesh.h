@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 namespace capsim::mesh {
 
@@ -21,10 +22,13 @@ enum class SpheroidMap {
   /// along meridians as around them.
   AxisScaling,
   /// Nodes moved along meridians so that meridional arc length is proportional to the sphere's polar
-  /// angle: uniform spacing along meridians, anisotropy only at the equator (≈1.5 at a/b = 2).
+  /// angle: uniform spacing along meridians, anisotropy only at the equator. The default: at a/b = 2 it
+  /// lowers the worst edge ratio from 2.0 to 1.6 and raises the smallest angle from 29° to 37° while
+  /// keeping element sizes more uniform than the plain scaling (measured in mesh_test).
   EqualArcLength,
   /// Nodes moved along meridians so that the map sphere → spheroid is conformal (isothermal latitude):
-  /// element angles are those of the sphere mesh up to the discretisation; sizes vary smoothly instead.
+  /// element angles are those of the sphere mesh up to the discretisation, but element areas vary by a
+  /// factor ≈ 9 at a/b = 2 (large tips, small equator), which shrinks the stable time step.
   Conformal,
 };
 
@@ -61,7 +65,7 @@ std::array<double, 2> spheroid_semi_axes(double aspect_ratio);
 
 /// @brief The capsule's reference mesh: the sphere mesh of `level` mapped to the spheroid a/b =
 /// aspect_ratio (revolution axis x1) with the given map. aspect_ratio = 1 gives the unit sphere.
-SurfaceMesh make_capsule_mesh(int level, double aspect_ratio, SpheroidMap map = SpheroidMap::Conformal);
+SurfaceMesh make_capsule_mesh(int level, double aspect_ratio, SpheroidMap map = SpheroidMap::EqualArcLength);
 
 /// @brief Element-shape statistics of the flat vertex triangles.
 struct MeshQuality {

@@ -1,0 +1,122 @@
+#include "solver/membrane/load_solver.h"
+
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/IterativeLinearSolvers>
+
+#include "solver/mesh/p2_element.h"
+#include "solver/quadrature/triangle_rule.h"
+
+namespace capsim::membrane {
+
+struct LoadSolver::Impl {
+  Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> cholmod;
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
+  std::vector<std::array<double, 6>> N;                      // per rule point
+  std::vector<std::array<std::array<double, 6>, 2>> dN;      // per rule point
+  std::vector<double> w;                                     // rule weights · ½
+  Eigen::Matrix3Xd previous_q;                               // CG warm start
+};
+
+LoadSolver::LoadSolver(const mesh::SurfaceMesh& mesh, Options options)
+    : mesh_(mesh), options_(options), impl_(std::make_unique<Impl>()) {
+  const auto& rule = quadrature::triangle_rule(options.quadrature_degree);
+  for (int q = 0; q < rule.size(); ++q) {
+    impl_->N.push_back(mesh::p2_shape(rule.points[q][1], rule.points[q][2]));
+    impl_->dN.push_back(mesh::p2_shape_gradients(rule.points[q][1], rule.points[q][2]));
+    impl_->w.push_back(0.5 * rule.weights[q]);
+  }
+  // Pattern from connectivity: every pair of nodes sharing an element.
+  const int n = mesh.num_nodes();
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(static_cast<std::size_t>(mesh.num_elements()) * 36);
+  for (const auto& el : mesh.elements)
+    for (int a : el)
+      for (int b : el) trip.emplace_back(a, b, 1.0);
+  M_.resize(n, n);
+  M_.setFromTriplets(trip.begin(), trip.end());
+  M_.makeCompressed();
+  // Map element-local entries to their slot in the compressed storage, so assembly writes values directly.
+  value_index_.resize(static_cast<std::size_t>(mesh.num_elements()) * 36);
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    const auto& el = mesh.elements[e];
+    for (int i = 0; i < 6; ++i)
+      for (int j = 0; j < 6; ++j) {
+        const int col = el[j], row = el[i];
+        const int* begin = M_.innerIndexPtr() + M_.outerIndexPtr()[col];
+        const int* end = M_.innerIndexPtr() + M_.outerIndexPtr()[col + 1];
+        const int* it = std::lower_bound(begin, end, row);
+        value_index_[static_cast<std::size_t>(e) * 36 + i * 6 + j] = static_cast<int>(it - M_.innerIndexPtr());
+      }
+  }
+  if (options_.backend == Backend::Cholmod) {
+    impl_->cholmod.analyzePattern(M_);
+    if (impl_->cholmod.info() != Eigen::Success) throw std::runtime_error("CHOLMOD: symbolic analysis failed");
+  }
+}
+
+LoadSolver::~LoadSolver() = default;
+
+void LoadSolver::assemble(const Eigen::Matrix3Xd& x) {
+  if (x.cols() != mesh_.num_nodes()) throw std::invalid_argument("LoadSolver: positions do not match the mesh");
+  double* val = M_.valuePtr();
+  std::fill(val, val + M_.nonZeros(), 0.0);
+  const int nq = static_cast<int>(impl_->w.size());
+  for (int e = 0; e < mesh_.num_elements(); ++e) {
+    const auto& el = mesh_.elements[e];
+    double local[36] = {};
+    for (int q = 0; q < nq; ++q) {
+      Eigen::Vector3d g1 = Eigen::Vector3d::Zero(), g2 = Eigen::Vector3d::Zero();
+      for (int a = 0; a < 6; ++a) {
+        g1 += impl_->dN[q][0][a] * x.col(el[a]);
+        g2 += impl_->dN[q][1][a] * x.col(el[a]);
+      }
+      const double da = impl_->w[q] * g1.cross(g2).norm();
+      const auto& N = impl_->N[q];
+      for (int i = 0; i < 6; ++i)
+        for (int j = 0; j < 6; ++j) local[i * 6 + j] += da * N[i] * N[j];
+    }
+    const int* slot = value_index_.data() + static_cast<std::size_t>(e) * 36;
+    for (int k = 0; k < 36; ++k) val[slot[k]] += local[k];
+  }
+}
+
+void LoadSolver::factorize() {
+  if (options_.backend == Backend::Cholmod) {
+    impl_->cholmod.factorize(M_);
+    if (impl_->cholmod.info() != Eigen::Success)
+      throw std::runtime_error("CHOLMOD: the mass matrix is not positive definite (surface degenerated)");
+  } else {
+    impl_->cg.setTolerance(options_.cg_tolerance);
+    impl_->cg.compute(M_);
+  }
+}
+
+void LoadSolver::solve(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
+  const Eigen::MatrixX3d rhs = R.transpose();
+  if (options_.backend == Backend::Cholmod) {
+    q = impl_->cholmod.solve(rhs).transpose();
+    last_iterations_ = 0;
+  } else {
+    if (impl_->previous_q.cols() != R.cols()) impl_->previous_q = Eigen::Matrix3Xd::Zero(3, R.cols());
+    Eigen::MatrixX3d guess = impl_->previous_q.transpose();
+    Eigen::MatrixX3d sol(R.cols(), 3);
+    last_iterations_ = 0;
+    for (int c = 0; c < 3; ++c) {
+      sol.col(c) = impl_->cg.solveWithGuess(rhs.col(c), guess.col(c));
+      last_iterations_ += static_cast<int>(impl_->cg.iterations());
+    }
+    q = sol.transpose();
+    impl_->previous_q = q;
+  }
+}
+
+void LoadSolver::compute_load(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
+  assemble(x);
+  factorize();
+  solve(R, q);
+}
+
+}  // namespace capsim::membrane

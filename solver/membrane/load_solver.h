@@ -1,0 +1,65 @@
+#pragma once
+/// @file
+/// @brief The membrane load q from the weak equilibrium M q = R (DESIGN.md §2), where
+/// M_ab = ∫_S φ_a φ_b dS is the P2 mass matrix on the *deformed* surface and R = ∂W/∂x.
+/// q is the load the fluids exert on the membrane (∇s·τ + q = 0): outward on an inflated sphere.
+
+#include <memory>
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include "solver/mesh/mesh.h"
+
+namespace capsim::membrane {
+
+/// @brief Solves M(x) q = R for the three load components at once.
+///
+/// Contract (Ceres style): the sparsity pattern of M is that of the mesh connectivity, built and analysed
+/// (fill-reducing ordering, symbolic factorisation) once in the constructor; every `solve` only refills the
+/// values on the current positions and refactorises numerically. Positions passed later must belong to the
+/// same mesh. Not thread-safe (the factorisation is cached state).
+class LoadSolver {
+ public:
+  /// @brief Linear-solver backend for the mass matrix.
+  enum class Backend {
+    Cholmod,            ///< sparse Cholesky (SuiteSparse CHOLMOD), symbolic analysis cached
+    ConjugateGradient,  ///< Jacobi-preconditioned CG, warm-started from the previous q
+  };
+  struct Options {
+    Backend backend = Backend::Cholmod;
+    int quadrature_degree = 6;      ///< exact for P2×P2 on flat elements
+    double cg_tolerance = 1e-12;    ///< relative residual for the CG backend
+  };
+
+  LoadSolver(const mesh::SurfaceMesh& mesh, Options options);
+  explicit LoadSolver(const mesh::SurfaceMesh& mesh) : LoadSolver(mesh, Options{}) {}
+  ~LoadSolver();
+  LoadSolver(const LoadSolver&) = delete;
+  LoadSolver& operator=(const LoadSolver&) = delete;
+
+  /// @brief Assembles M on positions x (values only, cached pattern).
+  void assemble(const Eigen::Matrix3Xd& x);
+  /// @brief Numeric factorisation (Cholmod) or preconditioner update (CG) of the last assembled M.
+  void factorize();
+  /// @brief q = M⁻¹ R for the last factorised M (columns are nodes).
+  void solve(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q);
+  /// @brief assemble(x), factorize(), solve(R, q) in one call.
+  void compute_load(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q);
+
+  /// @brief The last assembled mass matrix (lower and upper parts stored).
+  [[nodiscard]] const Eigen::SparseMatrix<double>& mass_matrix() const { return M_; }
+  /// @brief CG iterations of the last solve (0 for Cholmod).
+  [[nodiscard]] int last_iterations() const { return last_iterations_; }
+
+ private:
+  struct Impl;
+  const mesh::SurfaceMesh& mesh_;
+  Options options_;
+  Eigen::SparseMatrix<double> M_;
+  std::vector<int> value_index_;  // element-major 6×6 → position in M_.valuePtr()
+  std::unique_ptr<Impl> impl_;
+  int last_iterations_ = 0;
+};
+
+}  // namespace capsim::membrane

@@ -1,0 +1,181 @@
+#include "solver/membrane/membrane_mechanics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "solver/mesh/p2_element.h"
+#include "solver/quadrature/triangle_rule.h"
+
+namespace capsim::membrane {
+namespace {
+
+// Kinematics of one quadrature point: current tangents, metric and its inverse.
+struct PointKinematics {
+  Eigen::Vector3d g1, g2;
+  double g11, g12, g22, det_g;
+};
+
+}  // namespace
+
+MembraneMechanics::MembraneMechanics(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& reference,
+                                     const MembraneLaw& law, Options options)
+    : mesh_(mesh), law_(law) {
+  if (reference.cols() != mesh.num_nodes())
+    throw std::invalid_argument("MembraneMechanics: reference has " + std::to_string(reference.cols()) +
+                                " nodes, mesh has " + std::to_string(mesh.num_nodes()));
+  const auto& rule = quadrature::triangle_rule(options.quadrature_degree);
+  for (const auto& p : rule.points) dN_.push_back(mesh::p2_shape_gradients(p[1], p[2]));
+  ref_.reserve(static_cast<std::size_t>(mesh.num_elements()) * rule.size());
+  double max_area = 0.0;
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    const auto& el = mesh.elements[e];
+    for (int q = 0; q < rule.size(); ++q) {
+      Eigen::Vector3d G1 = Eigen::Vector3d::Zero(), G2 = Eigen::Vector3d::Zero();
+      for (int a = 0; a < 6; ++a) {
+        G1 += dN_[q][0][a] * reference.col(el[a]);
+        G2 += dN_[q][1][a] * reference.col(el[a]);
+      }
+      const double G11 = G1.dot(G1), G12 = G1.dot(G2), G22 = G2.dot(G2);
+      const double det = G11 * G22 - G12 * G12;
+      max_area = std::max(max_area, det);
+      if (!(det > 0.0))
+        throw std::invalid_argument("membrane: element " + std::to_string(e) + " of the reference surface is degenerate");
+      ref_.push_back({{G22 / det, -G12 / det, G11 / det}, rule.weights[q] * 0.5 * std::sqrt(det)});
+    }
+  }
+  // A collapsed element relative to the others is as bad as a zero one: its metric is ill-conditioned.
+  for (std::size_t i = 0; i < ref_.size(); ++i) {
+    const double det = 1.0 / (ref_[i].Ginv[0] * ref_[i].Ginv[2] - ref_[i].Ginv[1] * ref_[i].Ginv[1]);
+    if (det < 1e-20 * max_area)
+      throw std::invalid_argument("membrane: element " + std::to_string(i / rule.size()) +
+                                  " of the reference surface is degenerate");
+  }
+}
+
+template <class Visit>
+void MembraneMechanics::for_each_point(const Eigen::Matrix3Xd& x, Visit&& visit) const {
+  const int nq = static_cast<int>(dN_.size());
+  for (int e = 0; e < mesh_.num_elements(); ++e) {
+    const auto& el = mesh_.elements[e];
+    for (int q = 0; q < nq; ++q) {
+      PointKinematics k;
+      k.g1.setZero();
+      k.g2.setZero();
+      for (int a = 0; a < 6; ++a) {
+        k.g1 += dN_[q][0][a] * x.col(el[a]);
+        k.g2 += dN_[q][1][a] * x.col(el[a]);
+      }
+      k.g11 = k.g1.dot(k.g1);
+      k.g12 = k.g1.dot(k.g2);
+      k.g22 = k.g2.dot(k.g2);
+      k.det_g = k.g11 * k.g22 - k.g12 * k.g12;
+      if (!(k.det_g > 0.0))
+        throw DegenerateSurface("membrane: element " + std::to_string(e) + " collapsed or non-finite");
+      visit(e, q, ref_[static_cast<std::size_t>(e) * nq + q], k);
+    }
+  }
+}
+
+namespace {
+struct Invariants {
+  double I1, Js, l1, l2;
+};
+// Invariants and principal stretches from the mixed tensor C = G^{-1} g. The discriminant is formed as
+// (C¹₁ − C²₂)² + 4 C¹₂ C²₁ rather than tr² − 4 det, which would cancel catastrophically near an isotropic
+// state (λ1 ≈ λ2) and leave a spurious √ε ≈ 1e-8 split between the principal tensions.
+template <class Ref>
+Invariants invariants(const Ref& r, const PointKinematics& k) {
+  const double* Gi = r.Ginv;
+  const double C11 = Gi[0] * k.g11 + Gi[1] * k.g12, C12 = Gi[0] * k.g12 + Gi[1] * k.g22;
+  const double C21 = Gi[1] * k.g11 + Gi[2] * k.g12, C22 = Gi[1] * k.g12 + Gi[2] * k.g22;
+  const double trace = C11 + C22;
+  const double J2 = k.det_g * (Gi[0] * Gi[2] - Gi[1] * Gi[1]);
+  const double disc = std::sqrt(std::max(0.0, (C11 - C22) * (C11 - C22) + 4.0 * C12 * C21));
+  const double l1 = std::sqrt(0.5 * (trace + disc));
+  const double Js = std::sqrt(J2);
+  return {trace - 2.0, Js, l1, Js / l1};
+}
+}  // namespace
+
+MembraneState MembraneMechanics::evaluate(const Eigen::Matrix3Xd& x) const {
+  MembraneState s;
+  s.internal_force = Eigen::Matrix3Xd::Zero(3, x.cols());
+  s.tau_min = std::numeric_limits<double>::infinity();
+  s.tau_max = -std::numeric_limits<double>::infinity();
+  for_each_point(x, [&](int e, int q, const RefPoint& r, const PointKinematics& k) {
+    const Invariants inv = invariants(r, k);
+    s.energy += r.weight0 * law_.energy(inv.I1, inv.Js);
+    const EnergyDerivatives d = law_.derivatives(inv.I1, inv.Js);
+    const auto tau = std::array<double, 2>{2.0 * d.d_I1 * inv.l1 / inv.l2 + d.d_Js, 2.0 * d.d_I1 * inv.l2 / inv.l1 + d.d_Js};
+    s.tau_min = std::min(s.tau_min, tau[1]);
+    s.tau_max = std::max(s.tau_max, tau[0]);
+    // A^{αβ} = 2 ws_I1 G^{αβ} + ws_J Js g^{αβ}, with g^{αβ} the inverse current metric.
+    const double ginv11 = k.g22 / k.det_g, ginv12 = -k.g12 / k.det_g, ginv22 = k.g11 / k.det_g;
+    const double c1 = 2.0 * d.d_I1, c2 = d.d_Js * inv.Js;
+    const double A11 = c1 * r.Ginv[0] + c2 * ginv11;
+    const double A12 = c1 * r.Ginv[1] + c2 * ginv12;
+    const double A22 = c1 * r.Ginv[2] + c2 * ginv22;
+    // R_a += w0 (A^{1β} g_β ∂N_a/∂ξ + A^{2β} g_β ∂N_a/∂η).
+    const Eigen::Vector3d t1 = r.weight0 * (A11 * k.g1 + A12 * k.g2);
+    const Eigen::Vector3d t2 = r.weight0 * (A12 * k.g1 + A22 * k.g2);
+    const auto& el = mesh_.elements[e];
+    for (int a = 0; a < 6; ++a) s.internal_force.col(el[a]) += dN_[q][0][a] * t1 + dN_[q][1][a] * t2;
+  });
+  return s;
+}
+
+double MembraneMechanics::energy(const Eigen::Matrix3Xd& x) const {
+  double w = 0.0;
+  for_each_point(x, [&](int, int, const RefPoint& r, const PointKinematics& k) {
+    const Invariants inv = invariants(r, k);
+    w += r.weight0 * law_.energy(inv.I1, inv.Js);
+  });
+  return w;
+}
+
+std::vector<std::array<double, 2>> MembraneMechanics::principal_stretches(const Eigen::Matrix3Xd& x) const {
+  std::vector<std::array<double, 2>> out;
+  out.reserve(ref_.size());
+  for_each_point(x, [&](int, int, const RefPoint& r, const PointKinematics& k) {
+    const Invariants inv = invariants(r, k);
+    out.push_back({inv.l1, inv.l2});
+  });
+  return out;
+}
+
+std::vector<std::array<double, 2>> MembraneMechanics::principal_tensions(const Eigen::Matrix3Xd& x) const {
+  std::vector<std::array<double, 2>> out;
+  out.reserve(ref_.size());
+  for_each_point(x, [&](int, int, const RefPoint& r, const PointKinematics& k) {
+    const Invariants inv = invariants(r, k);
+    out.push_back(law_.tensions(inv.l1, inv.l2));
+  });
+  return out;
+}
+
+AreaVolume area_and_volume(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x, int quadrature_degree) {
+  const auto& rule = quadrature::triangle_rule(quadrature_degree);
+  AreaVolume av;
+  for (const auto& el : mesh.elements) {
+    for (int q = 0; q < rule.size(); ++q) {
+      const auto N = mesh::p2_shape(rule.points[q][1], rule.points[q][2]);
+      const auto dN = mesh::p2_shape_gradients(rule.points[q][1], rule.points[q][2]);
+      Eigen::Vector3d p = Eigen::Vector3d::Zero(), g1 = Eigen::Vector3d::Zero(), g2 = Eigen::Vector3d::Zero();
+      for (int a = 0; a < 6; ++a) {
+        p += N[a] * x.col(el[a]);
+        g1 += dN[0][a] * x.col(el[a]);
+        g2 += dN[1][a] * x.col(el[a]);
+      }
+      const Eigen::Vector3d n_da = g1.cross(g2);  // outward normal times the area element
+      const double w = 0.5 * rule.weights[q];
+      av.area += w * n_da.norm();
+      av.volume += w * p.dot(n_da) / 3.0;
+    }
+  }
+  return av;
+}
+
+}  // namespace capsim::membrane

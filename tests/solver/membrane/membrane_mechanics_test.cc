@@ -1,0 +1,189 @@
+#include "solver/membrane/membrane_mechanics.h"
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "solver/membrane/load_solver.h"
+
+namespace capsim::membrane {
+namespace {
+
+using Eigen::Matrix3Xd;
+
+// A smooth, large, non-affine deformation of the reference.
+Matrix3Xd smooth_deformation(const Matrix3Xd& X, double amp) {
+  Matrix3Xd x = X;
+  for (int i = 0; i < X.cols(); ++i) {
+    const double a = X(0, i), b = X(1, i), c = X(2, i);
+    x(0, i) += amp * (0.3 * a + std::sin(1.3 * b + 0.2) * c);
+    x(1, i) += amp * (-0.2 * b + std::cos(0.7 * a) * 0.4);
+    x(2, i) += amp * (0.25 * c * a + 0.1 * std::sin(2.0 * b));
+  }
+  return x;
+}
+
+TEST(AreaVolume, SphereConvergesUnderRefinement) {
+  double prev_a = 0, prev_v = 0;
+  std::printf("%5s %14s %14s %8s %8s\n", "level", "area err", "volume err", "order A", "order V");
+  for (int level = 0; level <= 4; ++level) {
+    const auto m = mesh::make_sphere_mesh(level);
+    const auto av = area_and_volume(m, m.nodes);
+    const double ea = std::abs(av.area - 4 * std::numbers::pi), ev = std::abs(av.volume - 4 * std::numbers::pi / 3);
+    // h halves per level: order = log2(e_{l-1}/e_l).
+    const double oa = level ? std::log2(prev_a / ea) : 0.0, ov = level ? std::log2(prev_v / ev) : 0.0;
+    std::printf("%5d %14.3e %14.3e %8.2f %8.2f\n", level, ea, ev, oa, ov);
+    if (level >= 2) {
+      EXPECT_GT(oa, 3.5) << "P2 surfaces should converge at about fourth order";
+      EXPECT_GT(ov, 3.5);
+    }
+    prev_a = ea;
+    prev_v = ev;
+  }
+}
+
+TEST(AreaVolume, SpheroidEnclosesUnitSphereVolume) {
+  for (double r : {0.5, 2.0}) {
+    const auto m = mesh::make_capsule_mesh(4, r);
+    EXPECT_NEAR(area_and_volume(m, m.nodes).volume, 4 * std::numbers::pi / 3, 2e-5) << "a/b=" << r;
+  }
+}
+
+class MembraneLaws : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(MembraneLaws, RigidMotionGivesNoForce) {
+  const auto law = make_law(GetParam(), 1.0);
+  const auto m = mesh::make_capsule_mesh(2, 2.0);
+  const MembraneMechanics mech(m, m.nodes, *law);
+  const Eigen::Matrix3d Q = Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.3, -1.0, 0.5).normalized()).toRotationMatrix();
+  const Matrix3Xd x = (Q * m.nodes).colwise() + Eigen::Vector3d(0.4, -2.0, 1.5);
+  const auto s = mech.evaluate(x);
+  // Force and load scales of a 10% deformation for comparison.
+  const Matrix3Xd deformed = smooth_deformation(m.nodes, 0.1);
+  const auto ref_state = mech.evaluate(deformed);
+  const double scale = ref_state.internal_force.cwiseAbs().maxCoeff();
+  LoadSolver ref_solver(m);
+  Matrix3Xd q_ref;
+  ref_solver.compute_load(deformed, ref_state.internal_force, q_ref);
+  const double q_scale = q_ref.cwiseAbs().maxCoeff();
+  // Round-off bound: positions of size |x| ≈ 2.5 on elements h ≈ 0.1 carry a strain error ε|x|/h ≈ 5e-15,
+  // i.e. ≈ 5e-14 of the 10% deformation; the mass-matrix solve amplifies it by its condition number (~10).
+  EXPECT_LT(s.internal_force.cwiseAbs().maxCoeff(), 1e-12 * scale);
+  EXPECT_NEAR(s.energy, 0.0, 1e-13);
+  EXPECT_NEAR(s.tau_min, 0.0, 1e-12);
+  EXPECT_NEAR(s.tau_max, 0.0, 1e-12);
+  LoadSolver solver(m);
+  Matrix3Xd q;
+  solver.compute_load(x, s.internal_force, q);
+  EXPECT_LT(q.cwiseAbs().maxCoeff(), 1e-11 * q_scale);
+}
+
+TEST_P(MembraneLaws, ForcesAreTheGradientOfTheEnergy) {
+  const auto law = make_law(GetParam(), 1.0);
+  const auto m = mesh::make_capsule_mesh(1, 2.0);
+  const MembraneMechanics mech(m, m.nodes, *law);
+  Matrix3Xd x = smooth_deformation(m.nodes, 0.3);
+  const auto s = mech.evaluate(x);
+  const double h = 1e-6;
+  for (int node : {0, 7, 25, 60, 100, 161}) {
+    for (int c = 0; c < 3; ++c) {
+      const double keep = x(c, node);
+      x(c, node) = keep + h;
+      const double wp = mech.energy(x);
+      x(c, node) = keep - h;
+      const double wm = mech.energy(x);
+      x(c, node) = keep;
+      const double fd = (wp - wm) / (2 * h);
+      EXPECT_NEAR(s.internal_force(c, node), fd, 1e-7 * (1.0 + std::abs(fd))) << "node " << node << " comp " << c;
+    }
+  }
+}
+
+// Inflated sphere x = λX: the load is normal and uniform with Laplace's value q·n = 2τ(λ)/(λ R0).
+TEST_P(MembraneLaws, InflatedSphereObeysLaplaceLaw) {
+  const auto law = make_law(GetParam(), 1.0);
+  const double lambda = 1.1;
+  const double tau = law->tensions(lambda, lambda)[0];
+  const double expected = 2.0 * tau / lambda;
+  if (GetParam() == "neo-hookean") {
+    EXPECT_NEAR(tau, 1.0 - std::pow(lambda, -6), 1e-14);
+  }
+  std::printf("%s, lambda = %.2f, q.n exact = %.6f\n%5s %14s %14s %8s\n", GetParam().c_str(), lambda, expected,
+              "level", "max |q.n-p|/p", "max |q_t|/p", "order");
+  double prev = 0.0;
+  for (int level = 0; level <= 4; ++level) {
+    const auto m = mesh::make_sphere_mesh(level);
+    const MembraneMechanics mech(m, m.nodes, *law);
+    const Matrix3Xd x = lambda * m.nodes;
+    const auto s = mech.evaluate(x);
+    LoadSolver solver(m);
+    Matrix3Xd q;
+    solver.compute_load(x, s.internal_force, q);
+    double err_n = 0.0, err_t = 0.0;
+    for (int i = 0; i < m.num_nodes(); ++i) {
+      const Eigen::Vector3d n = m.nodes.col(i);  // outward normal of the sphere
+      const double qn = q.col(i).dot(n);
+      err_n = std::max(err_n, std::abs(qn - expected) / expected);
+      err_t = std::max(err_t, (q.col(i) - qn * n).norm() / expected);
+    }
+    const double order = level ? std::log2(prev / err_n) : 0.0;
+    std::printf("%5d %14.3e %14.3e %8.2f\n", level, err_n, err_t, order);
+    if (level >= 2) {
+      EXPECT_GT(order, 1.5) << "Laplace error must fall under refinement";
+    }
+    if (level >= 3) {
+      EXPECT_LT(err_t, err_n) << "the load must be essentially normal";
+    }
+    prev = err_n;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Laws, MembraneLaws, ::testing::Values("neo-hookean", "skalak"));
+
+TEST(MembraneMechanics, PrincipalStretchesOfAnAffineStretch) {
+  const auto m = mesh::make_sphere_mesh(2);
+  const NeoHookeanLaw law;
+  const MembraneMechanics mech(m, m.nodes, law);
+  const auto st = mech.principal_stretches(1.3 * m.nodes);
+  for (const auto& s : st) {
+    EXPECT_NEAR(s[0], 1.3, 1e-12);
+    EXPECT_NEAR(s[1], 1.3, 1e-12);
+  }
+}
+
+TEST(MembraneMechanics, DegenerateElementsAreReported) {
+  auto m = mesh::make_sphere_mesh(1);
+  const NeoHookeanLaw law;
+  Matrix3Xd bad = m.nodes;
+  const auto& e = m.elements[3];
+  for (int a = 0; a < 6; ++a) bad.col(e[a]) = m.nodes.col(e[0]);  // element 3 collapsed to a point
+  EXPECT_THROW(MembraneMechanics(m, bad, law), std::invalid_argument);
+  const MembraneMechanics mech(m, m.nodes, law);
+  EXPECT_THROW((void)mech.evaluate(bad), DegenerateSurface);
+  Matrix3Xd nan = m.nodes;
+  nan(0, 5) = std::nan("");
+  EXPECT_THROW((void)mech.evaluate(nan), DegenerateSurface);
+}
+
+TEST(LoadSolver, CholmodAndConjugateGradientAgree) {
+  const auto m = mesh::make_capsule_mesh(2, 2.0);
+  const SkalakLaw law(1.0);
+  const MembraneMechanics mech(m, m.nodes, law);
+  const Matrix3Xd x = smooth_deformation(m.nodes, 0.2);
+  const auto s = mech.evaluate(x);
+  LoadSolver direct(m);
+  LoadSolver cg(m, {LoadSolver::Backend::ConjugateGradient, 6, 1e-13});
+  Matrix3Xd q1, q2;
+  direct.compute_load(x, s.internal_force, q1);
+  cg.compute_load(x, s.internal_force, q2);
+  EXPECT_LT((q1 - q2).cwiseAbs().maxCoeff(), 1e-9 * q1.cwiseAbs().maxCoeff());
+  EXPECT_GT(cg.last_iterations(), 0);
+  // The mass matrix integrates 1: Σ_ab M_ab = area.
+  EXPECT_NEAR(direct.mass_matrix().sum(), area_and_volume(m, x).area, 1e-12);
+}
+
+}  // namespace
+}  // namespace capsim::membrane

@@ -1,0 +1,118 @@
+#include "solver/mesh/mesh.h"
+
+#include <cmath>
+#include <cstdio>
+#include <set>
+
+#include <gtest/gtest.h>
+
+namespace capsim::mesh {
+namespace {
+
+TEST(SphereMesh, CountsFollowTheIcosahedronSubdivision) {
+  const int elements[] = {20, 80, 320, 1280, 5120};
+  const int nodes[] = {42, 162, 642, 2562, 10242};
+  for (int level = 0; level <= 4; ++level) {
+    const SurfaceMesh m = make_sphere_mesh(level);
+    EXPECT_EQ(m.num_elements(), elements[level]);
+    EXPECT_EQ(m.num_nodes(), nodes[level]);
+    int vertices = 0;
+    for (auto k : m.kind) vertices += k == NodeKind::Vertex;
+    EXPECT_EQ(vertices, 10 * (1 << (2 * level)) + 2);
+  }
+}
+
+TEST(SphereMesh, NodesOnUnitSphereAndElementsOutward) {
+  const SurfaceMesh m = make_sphere_mesh(3);
+  for (int i = 0; i < m.num_nodes(); ++i) EXPECT_NEAR(m.nodes.col(i).norm(), 1.0, 1e-15);
+  for (const auto& e : m.elements) {
+    const Eigen::Vector3d n = (m.nodes.col(e[1]) - m.nodes.col(e[0])).cross(m.nodes.col(e[2]) - m.nodes.col(e[0]));
+    EXPECT_GT(n.dot(m.nodes.col(e[0])), 0.0);
+  }
+}
+
+TEST(SphereMesh, EveryEdgeSharedByTwoElements) {
+  const SurfaceMesh m = make_sphere_mesh(2);
+  std::vector<int> count(m.num_nodes(), 0);
+  for (const auto& e : m.elements)
+    for (int a = 3; a < 6; ++a) ++count[e[a]];
+  for (int i = 0; i < m.num_nodes(); ++i)
+    if (m.kind[i] == NodeKind::MidSide) EXPECT_EQ(count[i], 2);
+  // Node → element adjacency agrees with the element list.
+  for (int i = 0; i < m.num_nodes(); ++i)
+    for (int k = m.node_element_offsets[i]; k < m.node_element_offsets[i + 1]; ++k) {
+      const auto& e = m.elements[m.node_elements[k]];
+      EXPECT_NE(std::find(e.begin(), e.end(), i), e.end());
+    }
+}
+
+class CapsuleMeshMaps : public ::testing::TestWithParam<std::tuple<double, SpheroidMap>> {};
+
+TEST_P(CapsuleMeshMaps, NodesOnSpheroidAndExactlyMirrorSymmetric) {
+  const auto [r, map] = GetParam();
+  const SurfaceMesh m = make_capsule_mesh(3, r, map);
+  const auto [a, b] = spheroid_semi_axes(r);
+  EXPECT_NEAR(a * b * b, 1.0, 1e-15);
+  EXPECT_NEAR(a / b, r, 1e-14);
+  std::set<int> seen;
+  for (int i = 0; i < m.num_nodes(); ++i) {
+    const Eigen::Vector3d x = m.nodes.col(i);
+    EXPECT_NEAR(x(0) * x(0) / (a * a) + (x(1) * x(1) + x(2) * x(2)) / (b * b), 1.0, 1e-13);
+    const int j = m.mirror_node[i];
+    ASSERT_GE(j, 0);
+    EXPECT_EQ(m.mirror_node[j], i);
+    EXPECT_EQ(m.nodes(0, j), x(0));
+    EXPECT_EQ(m.nodes(1, j), x(1));
+    EXPECT_EQ(m.nodes(2, j), -x(2));
+    seen.insert(j);
+  }
+  EXPECT_EQ(static_cast<int>(seen.size()), m.num_nodes());
+}
+
+INSTANTIATE_TEST_SUITE_P(AspectRatios, CapsuleMeshMaps,
+                         ::testing::Combine(::testing::Values(0.5, 2.0),
+                                            ::testing::Values(SpheroidMap::AxisScaling, SpheroidMap::EqualArcLength,
+                                                              SpheroidMap::Conformal)));
+
+// Measures the element quality of the three maps. The default (equal arc length) must beat the plain
+// axis scaling on angles, anisotropy and size spread; conformal must give near-sphere angles.
+TEST(CapsuleMesh, RedistributionImprovesElementShapes) {
+  const SurfaceMesh sphere = make_sphere_mesh(3);
+  const MeshQuality qs = mesh_quality(sphere);
+  std::printf("%-6s %-18s %10s %12s %12s %10s\n", "a/b", "map", "min angle", "max edge r.", "mean edge r.", "size r.");
+  std::printf("%-6s %-18s %10.2f %12.3f %12.3f %10.3f\n", "1", "sphere", qs.min_angle_deg, qs.max_edge_ratio,
+              qs.mean_edge_ratio, qs.size_ratio);
+  for (double r : {2.0, 0.5}) {
+    MeshQuality q[3];
+    const SpheroidMap maps[3] = {SpheroidMap::AxisScaling, SpheroidMap::EqualArcLength, SpheroidMap::Conformal};
+    const char* names[3] = {"axis-scaling", "equal-arc-length", "conformal"};
+    for (int k = 0; k < 3; ++k) {
+      q[k] = mesh_quality(make_capsule_mesh(3, r, maps[k]));
+      std::printf("%-6.1f %-18s %10.2f %12.3f %12.3f %10.3f\n", r, names[k], q[k].min_angle_deg, q[k].max_edge_ratio,
+                  q[k].mean_edge_ratio, q[k].size_ratio);
+    }
+    EXPECT_GT(q[1].min_angle_deg, q[0].min_angle_deg + 5.0) << "a/b=" << r;
+    EXPECT_LT(q[1].max_edge_ratio, q[0].max_edge_ratio - 0.2) << "a/b=" << r;
+    EXPECT_LT(q[1].size_ratio, q[0].size_ratio) << "a/b=" << r;
+    EXPECT_GT(q[2].min_angle_deg, q[1].min_angle_deg) << "a/b=" << r;
+    // Conformal keeps the sphere mesh's angles up to the discretisation of the map.
+    EXPECT_GT(q[2].min_angle_deg, qs.min_angle_deg - 5.0) << "a/b=" << r;
+  }
+}
+
+TEST(CapsuleMesh, BadParametersThrowClearly) {
+  EXPECT_THROW(make_sphere_mesh(-1), std::invalid_argument);
+  EXPECT_THROW(make_sphere_mesh(7), std::invalid_argument);
+  EXPECT_THROW(make_capsule_mesh(2, 0.0), std::invalid_argument);
+  EXPECT_THROW(make_capsule_mesh(2, -2.0), std::invalid_argument);
+  EXPECT_THROW(make_capsule_mesh(2, std::nan("")), std::invalid_argument);
+  EXPECT_THROW(parse_spheroid_map("stretched"), std::invalid_argument);
+  try {
+    make_sphere_mesh(9);
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("mesh.level"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace capsim::mesh

@@ -1,0 +1,239 @@
+#include "solver/diagnostics/period_analysis.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace capsim::diagnostics {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// Time of the vertex of the parabola through samples i−1, i, i+1 (refines a sampled minimum's time to
+// well below a step for a smooth minimum); clamped to the neighbours, so a kink (D12 → 0 with a V shape)
+// is still located within one step.
+double refined_time(std::span<const double> t, std::span<const double> y, std::size_t i) {
+  if (i == 0 || i + 1 >= y.size()) return t[i];
+  const double t0 = t[i - 1], t1 = t[i], t2 = t[i + 1];
+  const double y0 = y[i - 1], y1 = y[i], y2 = y[i + 1];
+  const double num = (t1 - t0) * (t1 - t0) * (y1 - y2) - (t1 - t2) * (t1 - t2) * (y1 - y0);
+  const double den = (t1 - t0) * (y1 - y2) - (t1 - t2) * (y1 - y0);
+  if (den == 0 || !std::isfinite(num / den)) return t1;
+  return std::clamp(t1 - 0.5 * num / den, t0, t2);
+}
+
+// Statistics of the samples [i0, i1] (time bounds tb, te already set in w).
+void fill_window(PeriodWindow& w, std::span<const double> t, std::span<const double> D12,
+                 std::span<const double> theta_u, std::span<const double> tau_min) {
+  const std::size_t i0 = w.i_begin, i1 = w.i_end;
+  w.min_D12 = *std::min_element(D12.begin() + i0, D12.begin() + i1 + 1);
+  w.max_D12 = *std::max_element(D12.begin() + i0, D12.begin() + i1 + 1);
+  w.max_tau_min = *std::max_element(tau_min.begin() + i0, tau_min.begin() + i1 + 1);
+  const auto [th_lo, th_hi] = std::minmax_element(theta_u.begin() + i0, theta_u.begin() + i1 + 1);
+  w.theta_amplitude = 0.5 * (*th_hi - *th_lo);
+  w.theta_sweep = theta_u[i1] - theta_u[i0];
+  double span = 0, sD = 0, sT = 0;
+  for (std::size_t i = i0; i < i1; ++i) {
+    const double h = t[i + 1] - t[i];
+    span += h;
+    sD += 0.5 * h * (D12[i] + D12[i + 1]);
+    sT += 0.5 * h * (theta_u[i] + theta_u[i + 1]);
+  }
+  w.mean_D12 = span > 0 ? sD / span : D12[i0];
+  w.theta_mean = span > 0 ? sT / span : theta_u[i0];
+}
+
+// Periods of a tumbling axis: back from the last sample, each window ends where the previous one began and
+// begins where unwrapped θ has turned by π more (interpolated). Returns the windows, most recent first.
+std::vector<PeriodWindow> tumbling_windows(std::span<const double> t, std::span<const double> theta_u,
+                                           int max_periods) {
+  std::vector<PeriodWindow> out;
+  const std::size_t n = t.size();
+  if (n < 2) return out;
+  // Going back in time a tumbling θ (decreasing for the clockwise shear vorticity) increases: direction s.
+  const double s = theta_u.front() >= theta_u.back() ? 1.0 : -1.0;
+  double level = theta_u.back();
+  double t_end = t.back();
+  std::size_t i_end = n - 1;
+  while (static_cast<int>(out.size()) < max_periods) {
+    // Latest sample j < i_end at which θ is π (or more) beyond the window's end level.
+    std::size_t j = i_end;
+    bool found = false;
+    while (j > 0) {
+      --j;
+      if (s * (theta_u[j] - level) >= kPi) {
+        found = true;
+        break;
+      }
+    }
+    if (!found) break;
+    const double target = level + s * kPi;
+    // Crossing between j and j + 1 (θ_u[j+1] is short of the target by construction).
+    const double a = theta_u[j], b = theta_u[j + 1];
+    const double f = (a == b) ? 0.0 : std::clamp((target - a) / (b - a), 0.0, 1.0);
+    PeriodWindow w;
+    w.t_begin = t[j] + f * (t[j + 1] - t[j]);
+    w.t_end = t_end;
+    w.i_begin = j;  // one sample beyond the crossing: never miss an extremum at the bound
+    w.i_end = i_end;
+    out.push_back(w);
+    level = target;
+    t_end = w.t_begin;
+    i_end = j + 1 < i_end ? j + 1 : j;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string_view to_string(Regime regime) {
+  switch (regime) {
+    case Regime::steady: return "steady";
+    case Regime::tumbling: return "tumbling";
+    case Regime::swinging: return "swinging";
+    case Regime::unknown: break;
+  }
+  return "unknown";
+}
+
+std::vector<double> unwrap_axis_angle(std::span<const double> theta) {
+  std::vector<double> u(theta.begin(), theta.end());
+  double offset = 0;
+  for (std::size_t i = 1; i < u.size(); ++i) {
+    const double jump = theta[i] - theta[i - 1];
+    // An axis angle is defined modulo π: remove the multiple of π that brings the jump into [−π/2, π/2].
+    offset -= kPi * std::round(jump / kPi);
+    u[i] = theta[i] + offset;
+  }
+  return u;
+}
+
+std::vector<std::size_t> significant_minima(std::span<const double> y, double prominence) {
+  // Hysteresis peak detection (Billauer's peakdet): alternate between looking for a maximum and a minimum;
+  // an extremum is confirmed once the signal has moved away from it by `prominence`.
+  std::vector<std::size_t> minima;
+  if (y.size() < 3) return minima;
+  double mn = y[0], mx = y[0];
+  std::size_t mn_at = 0;
+  bool look_for_max = true;
+  bool seen_max = false;  // a minimum must follow a confirmed maximum (not the record's first sample)
+  for (std::size_t i = 0; i < y.size(); ++i) {
+    const double v = y[i];
+    if (v > mx) mx = v;
+    if (v < mn) mn = v, mn_at = i;
+    if (look_for_max) {
+      if (v < mx - prominence) {
+        seen_max = true;
+        look_for_max = false;
+        mn = v;
+        mn_at = i;
+      }
+    } else if (v > mn + prominence) {
+      if (seen_max && mn_at > 0) minima.push_back(mn_at);
+      look_for_max = true;
+      mx = v;
+    }
+  }
+  return minima;
+}
+
+PeriodAnalysis analyse_periods(std::span<const double> t, std::span<const double> D12,
+                               std::span<const double> theta, std::span<const double> tau_min,
+                               const PeriodOptions& options) {
+  const std::size_t n = t.size();
+  if (D12.size() != n || theta.size() != n || tau_min.size() != n)
+    throw std::invalid_argument("analyse_periods: t, D12, theta and tau_min differ in length");
+  PeriodAnalysis res;
+  if (n < 3) return res;
+  const std::vector<double> theta_u = unwrap_axis_angle(theta);
+
+  auto finish = [&](Regime regime, std::vector<PeriodWindow> windows) {
+    res.regime = regime;
+    res.periods = std::move(windows);
+    for (auto& w : res.periods) fill_window(w, t, D12, theta_u, tau_min);
+    const PeriodWindow& last = res.periods.front();
+    res.period = last.period();
+    res.revolution_period = 2.0 * res.period;
+    res.min_D12 = last.min_D12;
+    res.max_tau_min = last.max_tau_min;
+    res.mean_D12 = last.mean_D12;
+    res.theta_mean = last.theta_mean;
+    res.theta_amplitude = last.theta_amplitude;
+    return res;
+  };
+
+  // 1. Steady: a stationary trailing window.
+  if (t.back() - t.front() >= options.steady_window) {
+    std::size_t i0 = n - 1;
+    while (i0 > 0 && t[i0 - 1] >= t.back() - options.steady_window) --i0;
+    const auto [d_lo, d_hi] = std::minmax_element(D12.begin() + i0, D12.end());
+    const auto [th_lo, th_hi] = std::minmax_element(theta_u.begin() + i0, theta_u.end());
+    const bool circular = *d_hi <= options.steady_tol_D12;
+    if (*d_hi - *d_lo <= options.steady_tol_D12 && (circular || *th_hi - *th_lo <= options.steady_tol_theta)) {
+      PeriodWindow w;
+      w.t_begin = t[i0];
+      w.t_end = t.back();
+      w.i_begin = i0;
+      w.i_end = n - 1;
+      finish(Regime::steady, {w});
+      res.period = 0;
+      res.revolution_period = 0;
+      return res;
+    }
+  }
+
+  // 2. Significant minima of D12, with a prominence scaled on the recent oscillation.
+  const auto half = D12.begin() + static_cast<std::ptrdiff_t>(n / 2);
+  const auto [lo, hi] = std::minmax_element(half, D12.end());
+  const double prominence = std::max(options.min_prominence, options.prominence_fraction * (*hi - *lo));
+  const std::vector<std::size_t> minima = significant_minima(D12, prominence);
+
+  const auto tumbling = tumbling_windows(t, theta_u, options.max_periods);
+  if (minima.size() >= 2) {
+    const std::size_t a = minima[minima.size() - 2], b = minima.back();
+    const bool turns = std::abs(theta_u[b] - theta_u[a]) > 0.5 * kPi;
+    // θ-based periods of a tumbling axis end at the last sample and do not depend on locating D12 minima;
+    // fall back to the minima only while θ has not yet turned by a full π.
+    if (turns && !tumbling.empty()) return finish(Regime::tumbling, tumbling);
+    const Regime regime = turns ? Regime::tumbling : Regime::swinging;
+    std::vector<PeriodWindow> windows;
+    for (std::size_t k = minima.size() - 1; k >= 1 && static_cast<int>(windows.size()) < options.max_periods;
+         --k) {
+      PeriodWindow w;
+      w.i_begin = minima[k - 1];
+      w.i_end = minima[k];
+      w.t_begin = refined_time(t, D12, w.i_begin);
+      w.t_end = refined_time(t, D12, w.i_end);
+      windows.push_back(w);
+    }
+    return finish(regime, std::move(windows));
+  }
+
+  // 3. Quasi-rigid tumbling: θ turns by π with no significant D12 oscillation.
+  if (!tumbling.empty()) return finish(Regime::tumbling, tumbling);
+
+  // 4. Not enough data.
+  return res;
+}
+
+PeriodAnalysis analyse_periods(const TimeSeries& series, const PeriodOptions& options) {
+  return analyse_periods(series.t, series.D12, series.theta, series.tau_min, options);
+}
+
+bool periodic_regime_converged(const PeriodAnalysis& analysis, const ConvergenceOptions& options) {
+  if (analysis.regime == Regime::steady) return true;
+  if (analysis.regime == Regime::unknown) return false;
+  const int needed = std::max(options.periods, 2);
+  if (static_cast<int>(analysis.periods.size()) < needed) return false;
+  for (int k = 0; k + 1 < needed; ++k) {
+    const PeriodWindow& a = analysis.periods[k];
+    const PeriodWindow& b = analysis.periods[k + 1];
+    if (std::abs(a.min_D12 - b.min_D12) > options.tol_D12) return false;
+    if (std::abs(a.max_tau_min - b.max_tau_min) > options.tol_tau_min) return false;
+    if (std::abs(a.period() - b.period()) > options.tol_period * std::max(a.period(), b.period())) return false;
+  }
+  return true;
+}
+
+}  // namespace capsim::diagnostics

@@ -1,0 +1,122 @@
+#pragma once
+/// @file
+/// @brief Periodic-regime analysis of the diagnostics time series: period, min D12, max τmin, mean D12 over
+/// the last full period, the regime (tumbling / swinging / steady), and the stopping test of DESIGN.md §4.
+///
+/// What "period" means here. The capsule (a spheroid, centrally symmetric) in linear shear keeps its central
+/// symmetry x → −x, so its shape repeats after half a material revolution: a tumbling capsule's long axis
+/// turns by π, a swinging capsule's membrane turns by half a turn. `period` is that shape period, which is
+/// the period of D12(t), θ(t) mod π and τmin(t) (each has one minimum and one maximum per period). The
+/// material point P needs two shape periods to come back: the seed's "period" of figure 1 (drawn over "one
+/// half period") is `revolution_period` = 2 · period. For a rigid tumbling ellipse (Jeffery orbit) the
+/// revolution period is 2π (r + 1/r) and `period` is π (r + 1/r). min D12 and max τmin over one shape
+/// period equal those over a revolution, so they are the seed's min D12 (eq. 12) and max τmin (eq. 13).
+///
+/// Cost: O(number of samples) per call; call it every few tenths of a time unit, not at every step.
+
+#include <cstddef>
+#include <limits>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "solver/diagnostics/time_series.h"
+
+namespace capsim::diagnostics {
+
+/// @brief Motion regime of the capsule (seed §3.1–3.2).
+enum class Regime {
+  unknown,   ///< not enough data for a full period or a stationary window
+  steady,    ///< D12 and θ stationary (spherical capsule: steady deformed shape, tank-treading membrane)
+  tumbling,  ///< the long axis keeps rotating with the vorticity: θ unwrapped turns through ±π/2 and beyond
+  swinging,  ///< the long axis oscillates about a mean inclination while the membrane rotates
+};
+
+/// @brief "unknown" | "steady" | "tumbling" | "swinging".
+std::string_view to_string(Regime regime);
+
+/// @brief Tunables of analyse_periods.
+struct PeriodOptions {
+  /// A minimum of D12 is significant when D12 rises by at least max(min_prominence,
+  /// prominence_fraction · (max − min of D12 over the second half of the record)) on both sides of it.
+  /// Small wiggles (sampling noise, wrinkles) are thus not taken for periods.
+  double prominence_fraction = 0.2;
+  double min_prominence = 1e-4;
+  /// Steady when, over the last `steady_window` time units, max − min of D12 ≤ steady_tol_D12 and of θ
+  /// (unwrapped) ≤ steady_tol_theta. θ is ignored when D12 ≤ steady_tol_D12 there (a circular section has
+  /// no long axis, its θ is noise).
+  double steady_window = 5.0;
+  double steady_tol_D12 = 1e-4;
+  double steady_tol_theta = 1e-3;
+  /// At most this many most-recent periods are analysed.
+  int max_periods = 16;
+};
+
+/// @brief One full shape period of the record.
+struct PeriodWindow {
+  double t_begin = 0, t_end = 0;        ///< period = t_end − t_begin (interpolated bounds)
+  std::size_t i_begin = 0, i_end = 0;   ///< samples [i_begin, i_end] over which the extrema are taken
+  double min_D12 = 0, max_D12 = 0, mean_D12 = 0;  ///< mean: trapezoidal time average
+  double max_tau_min = 0;               ///< max over the window of τmin(t), seed eq. (13)
+  double theta_sweep = 0;               ///< θ(end) − θ(begin), unwrapped: ≈ −π tumbling, ≈ 0 swinging
+  double theta_mean = 0, theta_amplitude = 0;  ///< time mean and half range of unwrapped θ
+  /// @brief Duration of the window.
+  [[nodiscard]] double period() const { return t_end - t_begin; }
+};
+
+/// @brief Result of analyse_periods. The scalar results are those of the last full period (periods[0]);
+/// NaN when unknown. For a steady regime: period = 0 and the scalars are over the stationary window.
+struct PeriodAnalysis {
+  Regime regime = Regime::unknown;
+  static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  double period = kNaN;             ///< shape period = period of D12(t) (see file comment)
+  double revolution_period = kNaN;  ///< 2 · period: return time of the material point P
+  double min_D12 = kNaN, max_tau_min = kNaN, mean_D12 = kNaN;
+  double theta_mean = kNaN, theta_amplitude = kNaN;
+  /// Complete periods found, the most recent first. Tumbling: successive turns of θ by π back from the
+  /// last sample. Swinging: between successive significant minima of D12.
+  std::vector<PeriodWindow> periods;
+};
+
+/// @brief Unwrap an axis inclination (defined modulo π): each jump of more than π/2 between samples is
+/// taken as a wrap and removed, so a tumbling axis gives a monotone θ and a swinging one stays bounded.
+std::vector<double> unwrap_axis_angle(std::span<const double> theta);
+
+/// @brief Indices of the significant local minima of y (hysteresis peak detection): a minimum is reported
+/// when y has fallen by at least `prominence` from a preceding maximum and rises by at least `prominence`
+/// after it. The first and last samples are never reported.
+std::vector<std::size_t> significant_minima(std::span<const double> y, double prominence);
+
+/// @brief Analyse the record: regime, period, min D12, max τmin, mean D12 over the last full period.
+///
+/// Rules, in order:
+/// 1. steady if the last steady_window is stationary (see PeriodOptions);
+/// 2. with ≥ 2 significant minima of D12: the last interval between them is one period; tumbling if θ turns
+///    there by more than π/2 (expected π), else swinging. Tumbling periods are then taken from θ (3);
+///    swinging periods are the intervals between successive minima;
+/// 3. tumbling without D12 oscillation (a quasi-rigid capsule at small Ca, D12 almost constant): θ has
+///    turned by π at least once; each period is the time for θ to turn by π, counted back from the last
+///    sample with linear interpolation;
+/// 4. otherwise unknown.
+/// All spans must have the same size and t must increase.
+/// @throws std::invalid_argument on mismatched sizes.
+PeriodAnalysis analyse_periods(std::span<const double> t, std::span<const double> D12,
+                               std::span<const double> theta, std::span<const double> tau_min,
+                               const PeriodOptions& options = {});
+
+/// @brief Same, on a TimeSeries.
+PeriodAnalysis analyse_periods(const TimeSeries& series, const PeriodOptions& options = {});
+
+/// @brief Tolerances of the stopping test.
+struct ConvergenceOptions {
+  double tol_D12 = 1e-3;      ///< absolute, on min D12 (D12 near the transition is ~0: no relative tol)
+  double tol_tau_min = 1e-3;  ///< absolute, on max τmin (units of Gs)
+  double tol_period = 0.02;   ///< relative, on the period
+  int periods = 2;            ///< number of successive periods that must agree pairwise (≥ 2)
+};
+
+/// @brief The stopping test of DESIGN.md §4: true when the regime is steady, or periodic (tumbling or
+/// swinging) with the last `periods` full periods agreeing pairwise on min D12, max τmin and the period.
+bool periodic_regime_converged(const PeriodAnalysis& analysis, const ConvergenceOptions& options = {});
+
+}  // namespace capsim::diagnostics

@@ -1,0 +1,254 @@
+// Period, extrema and regime detection on synthetic signals with known answers.
+#include "solver/diagnostics/period_analysis.h"
+
+#include <cmath>
+#include <functional>
+#include <numbers>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace capsim::diagnostics {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// Bring an axis angle into (−π/2, π/2], as ellipsoid_of_inertia reports it.
+double wrap_axis(double a) {
+  double w = std::remainder(a, kPi);
+  if (w <= -kPi / 2) w += kPi;
+  return w;
+}
+
+// Jeffery orbit of a rigid ellipse of aspect ratio r in v = (x2, 0, 0): tan φ = −(1/r) tan(t r/(r²+1)),
+// φ continuous and decreasing (clockwise with the vorticity). Revolution period 2π (r + 1/r).
+double jeffery_angle(double t, double r) {
+  const double psi = t * r / (r * r + 1.0);
+  // atan2 gives the angle mod 2π; add back the completed turns so the angle is continuous.
+  const double base = std::atan2(-std::sin(psi), r * std::cos(psi));
+  const double turns = std::floor((psi + kPi) / (2 * kPi));
+  return base - 2 * kPi * turns;
+}
+
+struct Signal {
+  std::vector<double> t, D12, theta, tau_min;
+};
+
+Signal sample(double t_end, double dt, const std::function<void(double, double&, double&, double&)>& f,
+              double jitter = 0.0) {
+  Signal s;
+  for (int i = 0; i * dt <= t_end; ++i) {
+    // Deterministic jitter of the sampling times: the analysis must not assume a constant step.
+    const double t = i * dt + (i > 0 ? jitter * dt * std::sin(12.9898 * i) : 0.0);
+    double d, th, tau;
+    f(t, d, th, tau);
+    s.t.push_back(t);
+    s.D12.push_back(d);
+    s.theta.push_back(th);
+    s.tau_min.push_back(tau);
+  }
+  return s;
+}
+
+PeriodAnalysis analyse(const Signal& s, const PeriodOptions& o = {}) {
+  return analyse_periods(s.t, s.D12, s.theta, s.tau_min, o);
+}
+
+TEST(UnwrapAxisAngle, RemovesWrapsOfPi) {
+  // A steadily decreasing axis, reported in (−π/2, π/2].
+  std::vector<double> raw, truth;
+  for (int i = 0; i < 400; ++i) {
+    truth.push_back(0.3 - 0.05 * i);
+    raw.push_back(wrap_axis(truth.back()));
+  }
+  const auto u = unwrap_axis_angle(raw);
+  for (std::size_t i = 0; i < u.size(); ++i) EXPECT_NEAR(u[i], truth[i], 1e-12) << i;
+}
+
+TEST(SignificantMinima, IgnoresWigglesBelowTheProminence) {
+  std::vector<double> y;
+  for (int i = 0; i < 2000; ++i) {
+    const double t = 0.01 * i;
+    y.push_back(std::cos(2 * kPi * t / 4.0) + 0.01 * std::sin(2 * kPi * t / 0.05));  // period 4, 5 periods
+  }
+  const auto m = significant_minima(y, 0.2);
+  ASSERT_EQ(m.size(), 5u);  // minima at t = 2, 6, 10, 14, 18
+  for (std::size_t k = 0; k < m.size(); ++k) EXPECT_NEAR(0.01 * m[k], 2.0 + 4.0 * k, 0.05);
+  // With a prominence below the wiggles, the wiggles count: many more minima.
+  EXPECT_GT(significant_minima(y, 0.001).size(), 50u);
+}
+
+TEST(PeriodAnalysis, RigidJefferyOrbitTumblesWithHalfTheRevolutionPeriod) {
+  const double r = 2.0, D0 = 1.0 / 3.0;
+  const Signal s = sample(40.0, 0.01, [&](double t, double& d, double& th, double& tau) {
+    d = D0;  // a rigid ellipse keeps its shape
+    th = wrap_axis(jeffery_angle(t, r));
+    tau = 0.0;
+  });
+  const auto a = analyse(s);
+  EXPECT_EQ(a.regime, Regime::tumbling);
+  EXPECT_NEAR(a.period, kPi * (r + 1 / r), 1e-3);
+  EXPECT_NEAR(a.revolution_period, 2 * kPi * (r + 1 / r), 2e-3);
+  EXPECT_NEAR(a.min_D12, D0, 1e-15);
+  ASSERT_GE(a.periods.size(), 4u);  // 40 / 7.85
+  for (const auto& w : a.periods) EXPECT_NEAR(w.theta_sweep, -kPi, 0.02);
+  EXPECT_TRUE(periodic_regime_converged(a));
+}
+
+TEST(PeriodAnalysis, DeformableTumblingGivesMinD12AndMaxTauMinOverOnePeriod) {
+  // A quasi-rigid Jeffery rotation with the shape squeezed in the compression quadrant (φ = −π/4):
+  // D12 = 1/3 + 0.05 sin 2φ has its minimum 1/3 − 0.05 there, once per turn of the axis by π.
+  const double r = 2.0;
+  const Signal s = sample(
+      50.0, 0.01,
+      [&](double t, double& d, double& th, double& tau) {
+        const double phi = jeffery_angle(t, r);
+        d = 1.0 / 3.0 + 0.05 * std::sin(2 * phi);
+        th = wrap_axis(phi);
+        tau = -0.02 + 0.03 * std::cos(2 * phi + 0.3);
+      },
+      0.3);
+  const auto a = analyse(s);
+  EXPECT_EQ(a.regime, Regime::tumbling);
+  EXPECT_NEAR(a.period, kPi * (r + 1 / r), 1e-3);
+  EXPECT_NEAR(a.min_D12, 1.0 / 3.0 - 0.05, 1e-5);
+  EXPECT_NEAR(a.max_tau_min, 0.01, 1e-5);
+  // The time mean of sin 2φ over a Jeffery period is not zero (the axis lingers near the flow direction),
+  // so only bound it.
+  EXPECT_GT(a.mean_D12, 1.0 / 3.0 - 0.05);
+  EXPECT_LT(a.mean_D12, 1.0 / 3.0 + 0.05);
+  EXPECT_TRUE(periodic_regime_converged(a));
+}
+
+TEST(PeriodAnalysis, SwingingOscillatesAboutAMeanInclination) {
+  const double T = 6.5, w = 2 * kPi / T;
+  const Signal s = sample(
+      40.0, 0.01,
+      [&](double t, double& d, double& th, double& tau) {
+        th = 0.3 + 0.15 * std::sin(w * t);
+        d = 0.3 + 0.08 * std::cos(w * t + 1.0);
+        tau = 0.05 + 0.02 * std::sin(w * t);
+      },
+      0.3);
+  const auto a = analyse(s);
+  EXPECT_EQ(a.regime, Regime::swinging);
+  EXPECT_NEAR(a.period, T, 1e-3);
+  EXPECT_NEAR(a.revolution_period, 2 * T, 2e-3);
+  EXPECT_NEAR(a.min_D12, 0.22, 1e-5);
+  EXPECT_NEAR(a.max_tau_min, 0.07, 1e-5);
+  EXPECT_NEAR(a.mean_D12, 0.3, 1e-4);
+  EXPECT_NEAR(a.theta_mean, 0.3, 1e-3);
+  EXPECT_NEAR(a.theta_amplitude, 0.15, 1e-4);
+  EXPECT_GE(a.periods.size(), 5u);
+  EXPECT_TRUE(periodic_regime_converged(a));
+}
+
+TEST(PeriodAnalysis, SwingingNearTheTransitionWithAKinkedMinimumStaysSwinging) {
+  // Near Ca*, D12 dips to ~0 with a V-shaped minimum and θ jumps quickly there; still no net rotation.
+  const double T = 8.0, w = 2 * kPi / T;
+  const Signal s = sample(40.0, 0.005, [&](double t, double& d, double& th, double& tau) {
+    d = 0.02 + 0.3 * std::abs(std::sin(0.5 * w * t));
+    th = 0.2 + 0.9 * std::sin(w * t + 0.5);
+    tau = std::cos(w * t);
+  });
+  const auto a = analyse(s);
+  EXPECT_EQ(a.regime, Regime::swinging);
+  EXPECT_NEAR(a.period, T, 0.01);
+  EXPECT_NEAR(a.min_D12, 0.02, 1e-4);
+  EXPECT_NEAR(a.max_tau_min, 1.0, 1e-4);
+}
+
+TEST(PeriodAnalysis, SphereReachesASteadyShape) {
+  auto f = [](double t, double& d, double& th, double& tau) {
+    d = 0.1 * (1 - std::exp(-t / 2));
+    th = kPi / 4 + 0.2 * std::exp(-t / 2);
+    tau = 0.3 * (1 - std::exp(-t / 2));
+  };
+  const auto a = analyse(sample(60.0, 0.01, f));
+  EXPECT_EQ(a.regime, Regime::steady);
+  EXPECT_EQ(a.period, 0.0);
+  EXPECT_NEAR(a.min_D12, 0.1, 1e-9);
+  EXPECT_NEAR(a.max_tau_min, 0.3, 1e-9);
+  EXPECT_NEAR(a.theta_mean, kPi / 4, 1e-9);
+  EXPECT_TRUE(periodic_regime_converged(a));
+  // Still relaxing at t = 8: neither steady nor periodic yet.
+  const auto early = analyse(sample(8.0, 0.01, f));
+  EXPECT_EQ(early.regime, Regime::unknown);
+  EXPECT_TRUE(std::isnan(early.period));
+  EXPECT_TRUE(std::isnan(early.min_D12));
+  EXPECT_FALSE(periodic_regime_converged(early));
+}
+
+TEST(PeriodAnalysis, UndeformedSphereIsSteadyWhateverItsNoisyInclination) {
+  // A circular section has no long axis: θ is round-off noise and must not prevent "steady".
+  const auto a = analyse(sample(10.0, 0.01, [](double t, double& d, double& th, double& tau) {
+    d = 1e-13 * (1 + std::sin(7 * t));
+    th = 1.5 * std::sin(1000 * t);
+    tau = 0;
+  }));
+  EXPECT_EQ(a.regime, Regime::steady);
+}
+
+TEST(PeriodAnalysis, TooLittleDataIsUnknown) {
+  const std::vector<double> t{0, 0.1}, d{0.3, 0.31}, th{0, -0.01}, tau{0, 0};
+  EXPECT_EQ(analyse_periods(t, d, th, tau).regime, Regime::unknown);
+  const std::vector<double> shorter{0.0};
+  EXPECT_THROW(analyse_periods(t, d, th, shorter), std::invalid_argument);
+}
+
+TEST(PeriodicConvergence, WaitsForTheTransientToDecay) {
+  // Tumbling with a decaying extra deformation: min D12 per period drifts, then settles.
+  const double r = 2.0;
+  auto f = [&](double t, double& d, double& th, double& tau) {
+    const double phi = jeffery_angle(t, r);
+    const double amp = 0.05 + 0.05 * std::exp(-t / 5);
+    d = 1.0 / 3.0 + amp * std::sin(2 * phi);
+    th = wrap_axis(phi);
+    tau = -0.02 + amp * std::cos(2 * phi);
+  };
+  const auto early = analyse(sample(20.0, 0.01, f));
+  ASSERT_EQ(early.regime, Regime::tumbling);
+  ASSERT_GE(early.periods.size(), 2u);
+  EXPECT_FALSE(periodic_regime_converged(early));
+  const auto late = analyse(sample(90.0, 0.01, f));
+  EXPECT_TRUE(periodic_regime_converged(late));
+  EXPECT_NEAR(late.min_D12, 1.0 / 3.0 - 0.05, 1e-4);
+  // A stricter tolerance or more agreeing periods are harder to meet.
+  ConvergenceOptions strict;
+  strict.tol_D12 = 1e-9;
+  EXPECT_FALSE(periodic_regime_converged(late, strict));
+  ConvergenceOptions many;
+  many.periods = 30;  // more periods than recorded
+  EXPECT_FALSE(periodic_regime_converged(late, many));
+}
+
+TEST(PeriodicConvergence, DetectsAChangingPeriod) {
+  // Same amplitude every cycle but a period still lengthening: not converged.
+  auto f = [](double t, double& d, double& th, double& tau) {
+    // Instantaneous period 6 / (1 + 0.8 e^(−t/15)): successive periods near t = 30 differ by ≈ 4 %.
+    const double phase = 2 * kPi * (t / 6.0 - 2.0 * std::exp(-t / 15));
+    d = 0.3 + 0.1 * std::cos(phase);
+    th = 0.2 + 0.1 * std::sin(phase);
+    tau = 0.0;
+  };
+  const auto a = analyse(sample(30.0, 0.01, f));
+  ASSERT_EQ(a.regime, Regime::swinging);
+  ASSERT_GE(a.periods.size(), 2u);
+  const double change = std::abs(a.periods[0].period() / a.periods[1].period() - 1);
+  EXPECT_GT(change, 0.02);
+  EXPECT_FALSE(periodic_regime_converged(a));
+  // Amplitude and τmin are the same every cycle: only the period criterion refuses, as a looser one shows.
+  ConvergenceOptions loose;
+  loose.tol_period = 2 * change;
+  EXPECT_TRUE(periodic_regime_converged(a, loose));
+}
+
+TEST(Regime, Names) {
+  EXPECT_EQ(to_string(Regime::tumbling), "tumbling");
+  EXPECT_EQ(to_string(Regime::swinging), "swinging");
+  EXPECT_EQ(to_string(Regime::steady), "steady");
+  EXPECT_EQ(to_string(Regime::unknown), "unknown");
+}
+
+}  // namespace
+}  // namespace capsim::diagnostics

@@ -1,0 +1,370 @@
+#include "solver/stokes/single_layer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "solver/mesh/p2_element.h"
+#include "solver/quadrature/triangle_rule.h"
+
+namespace capsim::stokes {
+namespace {
+
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Reference coordinates of the 6 local nodes.
+constexpr double kRefNode[6][2] = {{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}, {0.5, 0.0}, {0.5, 0.5}, {0.0, 0.5}};
+
+// Sub-triangles (apex P, then A, B) of the Duffy map for each local node: one (the element itself, apex at
+// the corner) for a vertex, two for a mid-side node (apex at the mid-side, split through the opposite vertex).
+struct SubTriangle {
+  int a, b;  // reference vertices 0..2 opposite the apex
+};
+const std::vector<SubTriangle>& sub_triangles(int local) {
+  static const std::vector<SubTriangle> table[6] = {
+      {{1, 2}},          // vertex 0
+      {{2, 0}},          // vertex 1
+      {{0, 1}},          // vertex 2
+      {{1, 2}, {2, 0}},  // mid-side 3 on edge 0–1
+      {{2, 0}, {0, 1}},  // mid-side 4 on edge 1–2
+      {{0, 1}, {1, 2}},  // mid-side 5 on edge 2–0
+  };
+  return table[local];
+}
+
+}  // namespace
+
+SingleLayer::SingleLayer(const mesh::SurfaceMesh& mesh, const SingleLayerOptions& options) : opt_(options) {
+  const auto& rule = quadrature::triangle_rule(opt_.regular_degree);  // throws for a bad degree
+  if (opt_.duffy_order < 1)
+    throw std::invalid_argument("stokes: duffy_order must be >= 1, got " + std::to_string(opt_.duffy_order));
+  if (!(opt_.symmetry_tol >= 0.0)) throw std::invalid_argument("stokes: symmetry_tol must be >= 0");
+  if (opt_.near_subdivision < 0 || opt_.near_subdivision > 4)
+    throw std::invalid_argument("stokes: near_subdivision must be 0..4, got " +
+                                std::to_string(opt_.near_subdivision));
+  const auto& near_rule = quadrature::triangle_rule(opt_.near_degree);
+
+  num_nodes_ = mesh.num_nodes();
+  elements_ = mesh.elements;
+  for (const auto& el : elements_)
+    for (int a : el)
+      if (a < 0 || a >= num_nodes_) throw std::invalid_argument("stokes: element refers to a missing node");
+  if (static_cast<int>(mesh.node_element_offsets.size()) != num_nodes_ + 1)
+    throw std::invalid_argument("stokes: mesh node→element offsets have the wrong size");
+
+  // Node → (element, local index) incidences.
+  node_offsets_ = mesh.node_element_offsets;
+  inc_element_.resize(mesh.node_elements.size());
+  inc_local_.resize(mesh.node_elements.size());
+  for (int i = 0; i < num_nodes_; ++i) {
+    for (int k = node_offsets_[i]; k < node_offsets_[i + 1]; ++k) {
+      const int e = mesh.node_elements[k];
+      const auto& el = elements_.at(e);
+      const auto it = std::find(el.begin(), el.end(), i);
+      if (it == el.end()) throw std::invalid_argument("stokes: node→element list inconsistent with elements");
+      inc_element_[k] = e;
+      inc_local_[k] = static_cast<int>(it - el.begin());
+    }
+  }
+  if (static_cast<int>(mesh.mirror_node.size()) == num_nodes_) mirror_ = mesh.mirror_node;
+
+  auto shape_at = [](double xi, double eta, double w) {
+    ShapeAt s{};
+    s.w = w;
+    const auto n = mesh::p2_shape(xi, eta);
+    const auto g = mesh::p2_shape_gradients(xi, eta);
+    for (int a = 0; a < 6; ++a) {
+      s.n[a] = n[a];
+      s.dxi[a] = g[0][a];
+      s.deta[a] = g[1][a];
+    }
+    return s;
+  };
+
+  // Regular rule: ∫_T f dξdη = ½ Σ w f.
+  rule_size_ = rule.size();
+  for (int k = 0; k < rule.size(); ++k)
+    regular_.push_back(shape_at(rule.points[k][1], rule.points[k][2], 0.5 * rule.weights[k]));
+
+  // Duffy points: apex P, opposite edge A→B; (s, t) ∈ [0,1]² ↦ P + s (A − P) + s t (B − A), Jacobian
+  // s |det(A − P, B − P)|.
+  const auto gl = quadrature::gauss_legendre(opt_.duffy_order);
+  for (int l = 0; l < 6; ++l) {
+    const double px = kRefNode[l][0], py = kRefNode[l][1];
+    for (const auto& st : sub_triangles(l)) {
+      const double ax = kRefNode[st.a][0] - px, ay = kRefNode[st.a][1] - py;
+      const double bx = kRefNode[st.b][0] - px, by = kRefNode[st.b][1] - py;
+      const double det = std::abs(ax * by - ay * bx);
+      for (int i = 0; i < opt_.duffy_order; ++i) {
+        const double s = gl.nodes[i];
+        for (int j = 0; j < opt_.duffy_order; ++j) {
+          const double t = gl.nodes[j];
+          const double xi = px + s * (ax + t * (bx - ax)), eta = py + s * (ay + t * (by - ay));
+          duffy_[l].push_back(shape_at(xi, eta, gl.weights[i] * gl.weights[j] * s * det));
+        }
+      }
+    }
+  }
+
+  if (opt_.near_subdivision > 0) {
+    // Sub-triangles of the reference triangle (regular 4-split, near_subdivision times), the rule on each.
+    using Tri = std::array<std::array<double, 2>, 3>;
+    std::vector<Tri> tris = {Tri{{{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}}}};
+    for (int k = 0; k < opt_.near_subdivision; ++k) {
+      std::vector<Tri> next;
+      for (const Tri& t : tris) {
+        auto mid = [&](int a, int b) {
+          return std::array<double, 2>{0.5 * (t[a][0] + t[b][0]), 0.5 * (t[a][1] + t[b][1])};
+        };
+        const auto m01 = mid(0, 1), m12 = mid(1, 2), m20 = mid(2, 0);
+        next.push_back({t[0], m01, m20});
+        next.push_back({m01, t[1], m12});
+        next.push_back({m20, m12, t[2]});
+        next.push_back({m12, m20, m01});
+      }
+      tris = std::move(next);
+    }
+    for (const Tri& t : tris) {
+      const double ax = t[1][0] - t[0][0], ay = t[1][1] - t[0][1], bx = t[2][0] - t[0][0], by = t[2][1] - t[0][1];
+      const double det = std::abs(ax * by - ay * bx);
+      for (int k = 0; k < near_rule.size(); ++k) {
+        const double u = near_rule.points[k][1], v = near_rule.points[k][2];
+        near_rule_.push_back(
+            shape_at(t[0][0] + u * ax + v * bx, t[0][1] + u * ay + v * by, 0.5 * near_rule.weights[k] * det));
+      }
+    }
+    // Near-singular neighbours: elements sharing a vertex with an element that contains the node.
+    near_offsets_.assign(1, 0);
+    std::vector<int> own, cand;
+    for (int i = 0; i < num_nodes_; ++i) {
+      own.assign(mesh.node_elements.begin() + node_offsets_[i], mesh.node_elements.begin() + node_offsets_[i + 1]);
+      std::sort(own.begin(), own.end());
+      cand.clear();
+      for (int e : own)
+        for (int a = 0; a < 3; ++a) {
+          const int v = elements_[e][a];
+          for (int k = node_offsets_[v]; k < node_offsets_[v + 1]; ++k) cand.push_back(mesh.node_elements[k]);
+        }
+      std::sort(cand.begin(), cand.end());
+      cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+      for (int e : cand)
+        if (!std::binary_search(own.begin(), own.end(), e)) near_elements_.push_back(e);
+      near_offsets_.push_back(static_cast<int>(near_elements_.size()));
+    }
+  }
+}
+
+bool SingleLayer::is_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) const {
+  if (mirror_.empty() || x.cols() != num_nodes_ || q.cols() != num_nodes_) return false;
+  const double lx = (x.rowwise().maxCoeff() - x.rowwise().minCoeff()).norm();
+  const double lq = q.colwise().norm().maxCoeff();
+  const double tx = opt_.symmetry_tol * lx, tq = opt_.symmetry_tol * lq;
+  for (int i = 0; i < num_nodes_; ++i) {
+    const int m = mirror_[i];
+    const double ex = std::abs(x(0, m) - x(0, i)) + std::abs(x(1, m) - x(1, i)) + std::abs(x(2, m) + x(2, i));
+    const double eq = std::abs(q(0, m) - q(0, i)) + std::abs(q(1, m) - q(1, i)) + std::abs(q(2, m) + q(2, i));
+    if (!(ex <= tx) || !(eq <= tq)) return false;  // also false for NaN
+  }
+  return true;
+}
+
+void SingleLayer::layout(const std::vector<ShapeAt>& rule, const std::vector<std::array<int, 6>>& elements,
+                         const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, AlignedVector& px, AlignedVector& py,
+                         AlignedVector& pz, AlignedVector& pqx, AlignedVector& pqy, AlignedVector& pqz, int width) {
+  const int ne = static_cast<int>(elements.size()), nq = static_cast<int>(rule.size());
+  const int n = ne * nq;
+  const int npad = (n + width - 1) / width * width;
+  for (auto* v : {&px, &py, &pz, &pqx, &pqy, &pqz}) v->assign(static_cast<std::size_t>(npad), 0.0);
+#pragma omp parallel for schedule(static)
+  for (int e = 0; e < ne; ++e) {
+    const auto& el = elements[e];
+    double X[6][3], Q[6][3];
+    for (int a = 0; a < 6; ++a)
+      for (int c = 0; c < 3; ++c) {
+        X[a][c] = x(c, el[a]);
+        Q[a][c] = q(c, el[a]);
+      }
+    for (int k = 0; k < nq; ++k) {
+      const ShapeAt& s = rule[k];
+      double p[3] = {0, 0, 0}, t1[3] = {0, 0, 0}, t2[3] = {0, 0, 0}, qq[3] = {0, 0, 0};
+      for (int a = 0; a < 6; ++a)
+        for (int c = 0; c < 3; ++c) {
+          p[c] += s.n[a] * X[a][c];
+          t1[c] += s.dxi[a] * X[a][c];
+          t2[c] += s.deta[a] * X[a][c];
+          qq[c] += s.n[a] * Q[a][c];
+        }
+      const double nx = t1[1] * t2[2] - t1[2] * t2[1], ny = t1[2] * t2[0] - t1[0] * t2[2],
+                   nz = t1[0] * t2[1] - t1[1] * t2[0];
+      const double wj = s.w * std::sqrt(nx * nx + ny * ny + nz * nz);
+      const int j = e * nq + k;
+      px[j] = p[0];
+      py[j] = p[1];
+      pz[j] = p[2];
+      pqx[j] = wj * qq[0];
+      pqy[j] = wj * qq[1];
+      pqz[j] = wj * qq[2];
+    }
+  }
+}
+
+kernel::Sources SingleLayer::build_sources(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) {
+  layout(regular_, elements_, x, q, sx_, sy_, sz_, sqx_, sqy_, sqz_, kernel::simd_width());
+  return {sx_.data(), sy_.data(), sz_.data(), sqx_.data(), sqy_.data(), sqz_.data(), static_cast<int>(sx_.size())};
+}
+
+namespace {
+// acc += sign · Σ_{p ∈ [begin, end)} J(x0, x_p)·wq_p (short contiguous blocks; vectorised over p).
+inline void add_block(const double x0[3], const double* px, const double* py, const double* pz, const double* qx,
+                      const double* qy, const double* qz, int begin, int end, double sign, double acc[3]) {
+  double ax = 0.0, ay = 0.0, az = 0.0;
+#pragma omp simd reduction(+ : ax, ay, az)
+  for (int p = begin; p < end; ++p) {
+    const double dx = x0[0] - px[p], dy = x0[1] - py[p], dz = x0[2] - pz[p];
+    const double r2 = dx * dx + dy * dy + dz * dz;
+    const double inv = r2 == 0.0 ? 0.0 : 1.0 / std::sqrt(r2);
+    const double sc = (dx * qx[p] + dy * qy[p] + dz * qz[p]) * inv * inv * inv;
+    ax += qx[p] * inv + dx * sc;
+    ay += qy[p] * inv + dy * sc;
+    az += qz[p] * inv + dz * sc;
+  }
+  acc[0] += sign * ax;
+  acc[1] += sign * ay;
+  acc[2] += sign * az;
+}
+}  // namespace
+
+void SingleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q,
+                                      const std::vector<int>& targets, Eigen::Matrix3Xd& u) const {
+  const int nt = static_cast<int>(targets.size()), nq = rule_size_;
+  const int nr = static_cast<int>(near_rule_.size());
+#pragma omp parallel for schedule(dynamic, 16)
+  for (int it = 0; it < nt; ++it) {
+    const int i = targets[it];
+    const double x0[3] = {x(0, i), x(1, i), x(2, i)};
+    double acc[3] = {0.0, 0.0, 0.0};
+    for (int k = node_offsets_[i]; k < node_offsets_[i + 1]; ++k) {
+      const int e = inc_element_[k], l = inc_local_[k];
+      const auto& el = elements_[e];
+      // Remove what the regular rule counted for this element ...
+      add_block(x0, sx_.data(), sy_.data(), sz_.data(), sqx_.data(), sqy_.data(), sqz_.data(), e * nq, (e + 1) * nq,
+                -1.0, acc);
+      // ... and add the Duffy integral with the node at the apex. Positions relative to x0 (Σ N_a = 1)
+      // avoid cancellation near the apex.
+      double R[6][3], Q[6][3];
+      for (int a = 0; a < 6; ++a)
+        for (int c = 0; c < 3; ++c) {
+          R[a][c] = x(c, el[a]) - x0[c];
+          Q[a][c] = q(c, el[a]);
+        }
+      for (const ShapeAt& s : duffy_[l]) {
+        double d[3] = {0, 0, 0}, t1[3] = {0, 0, 0}, t2[3] = {0, 0, 0}, qq[3] = {0, 0, 0};
+        for (int a = 0; a < 6; ++a)
+          for (int c = 0; c < 3; ++c) {
+            d[c] += s.n[a] * R[a][c];
+            t1[c] += s.dxi[a] * R[a][c];
+            t2[c] += s.deta[a] * R[a][c];
+            qq[c] += s.n[a] * Q[a][c];
+          }
+        const double nx = t1[1] * t2[2] - t1[2] * t2[1], ny = t1[2] * t2[0] - t1[0] * t2[2],
+                     nz = t1[0] * t2[1] - t1[1] * t2[0];
+        const double wj = s.w * std::sqrt(nx * nx + ny * ny + nz * nz);
+        kernel::add_stokeslet(-d[0], -d[1], -d[2], wj * qq[0], wj * qq[1], wj * qq[2], acc);
+      }
+    }
+    // Near-singular neighbours: regular rule out, subdivided rule in.
+    if (nr > 0) {
+      for (int k = near_offsets_[i]; k < near_offsets_[i + 1]; ++k) {
+        const int e = near_elements_[k];
+        add_block(x0, sx_.data(), sy_.data(), sz_.data(), sqx_.data(), sqy_.data(), sqz_.data(), e * nq,
+                  (e + 1) * nq, -1.0, acc);
+        add_block(x0, nx_.data(), ny_.data(), nz_.data(), nqx_.data(), nqy_.data(), nqz_.data(), e * nr,
+                  (e + 1) * nr, 1.0, acc);
+      }
+    }
+    u(0, i) += acc[0];
+    u(1, i) += acc[1];
+    u(2, i) += acc[2];
+  }
+}
+
+void SingleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Eigen::Matrix3Xd& u) {
+  if (x.cols() != num_nodes_ || q.cols() != num_nodes_)
+    throw std::invalid_argument("stokes: x and q must have " + std::to_string(num_nodes_) + " columns (got " +
+                                std::to_string(x.cols()) + " and " + std::to_string(q.cols()) + ")");
+  const double t0 = now_s();
+  bool sym = false;
+  if (opt_.symmetry != Symmetry::Off) {
+    sym = is_symmetric(x, q);
+    if (!sym && opt_.symmetry == Symmetry::On)
+      throw std::invalid_argument("stokes: symmetry forced on but the scene is not symmetric under x3 -> -x3");
+  }
+
+  const kernel::Sources src = build_sources(x, q);
+  const double t1 = now_s();
+
+  // Targets: all nodes, or one of each mirror pair (the one with the larger x3; a node on the plane is its
+  // own image and is evaluated).
+  target_ids_.clear();
+  for (int i = 0; i < num_nodes_; ++i) {
+    if (sym) {
+      const int m = mirror_[i];
+      const bool mine = m == i || x(2, i) > x(2, m) || (x(2, i) == x(2, m) && i < m);
+      if (!mine) continue;
+    }
+    target_ids_.push_back(i);
+  }
+  const int nt = static_cast<int>(target_ids_.size());
+  for (auto* v : {&tx_, &ty_, &tz_, &ux_, &uy_, &uz_}) v->resize(static_cast<std::size_t>(nt));
+  for (int k = 0; k < nt; ++k) {
+    tx_[k] = x(0, target_ids_[k]);
+    ty_[k] = x(1, target_ids_[k]);
+    tz_[k] = x(2, target_ids_[k]);
+  }
+  const kernel::Targets tg{tx_.data(), ty_.data(), tz_.data(), nt};
+  const kernel::Result res{ux_.data(), uy_.data(), uz_.data()};
+  if (opt_.kernel == KernelChoice::Fast)
+    kernel::sum_fast(tg, src, res, opt_.fast);
+  else
+    kernel::sum_plain(tg, src, res);
+  const double t2 = now_s();
+
+  u.resize(3, num_nodes_);
+  for (int k = 0; k < nt; ++k) {
+    u(0, target_ids_[k]) = ux_[k];
+    u(1, target_ids_[k]) = uy_[k];
+    u(2, target_ids_[k]) = uz_[k];
+  }
+  if (!near_rule_.empty()) layout(near_rule_, elements_, x, q, nx_, ny_, nz_, nqx_, nqy_, nqz_, 1);
+  singular_correction(x, q, target_ids_, u);
+  if (sym) {
+    for (int k = 0; k < nt; ++k) {
+      const int i = target_ids_[k], m = mirror_[i];
+      if (m == i) continue;
+      u(0, m) = u(0, i);
+      u(1, m) = u(1, i);
+      u(2, m) = -u(2, i);
+    }
+  }
+  const double t3 = now_s();
+
+  stats_.used_symmetry = sym;
+  stats_.targets = nt;
+  stats_.sources = num_quadrature_points();
+  stats_.build_s = t1 - t0;
+  stats_.regular_s = t2 - t1;
+  stats_.singular_s = t3 - t2;
+  stats_.total_s = t3 - t0;
+}
+
+Eigen::Matrix3Xd SingleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) {
+  Eigen::Matrix3Xd u;
+  apply(x, q, u);
+  return u;
+}
+
+}  // namespace capsim::stokes

@@ -1,0 +1,240 @@
+#include "solver/stokes/stokeslet.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#if defined(__AVX512F__) || defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
+namespace capsim::stokes::kernel {
+namespace {
+
+// ---------------------------------------------------------------------------------------------------
+// 1/r refinement. With y ≈ r2^{-1/2} of relative error δ, e = 1 − r2 y² ≈ −2δ and
+//   r2^{-1/2} = y (1 − e)^{-1/2} = y (1 + e/2 + 3e²/8 + 5e³/16 + 35e⁴/128 + 63e⁵/256 + …).
+// rsqrt14 (AVX-512): |δ| ≤ 2^-14, |e| ≤ 2^-13: terms to e³ leave 35/128·e⁴ ≤ 6e-17 (full double).
+// rsqrtps (AVX2, single precision): |δ| ≤ 1.5·2^-12, |e| ≤ 7.4e-4: terms to e⁴ leave 63/256·e⁵ ≤ 6e-17.
+constexpr double kC1 = 0.5, kC2 = 0.375, kC3 = 0.3125, kC4 = 35.0 / 128.0;
+
+#if defined(__AVX512F__)
+constexpr int kLanes = 8;
+constexpr const char* kIsa = "avx512";
+
+template <int B, bool kNewton>
+inline void tile(const double* tx, const double* ty, const double* tz, const Sources& s, double* ux, double* uy,
+                 double* uz) {
+  __m512d X[B], Y[B], Z[B], UX[B], UY[B], UZ[B];
+  for (int b = 0; b < B; ++b) {
+    X[b] = _mm512_loadu_pd(tx + kLanes * b);
+    Y[b] = _mm512_loadu_pd(ty + kLanes * b);
+    Z[b] = _mm512_loadu_pd(tz + kLanes * b);
+    UX[b] = _mm512_setzero_pd();
+    UY[b] = _mm512_setzero_pd();
+    UZ[b] = _mm512_setzero_pd();
+  }
+  const __m512d zero = _mm512_setzero_pd(), one = _mm512_set1_pd(1.0);
+  const __m512d c1 = _mm512_set1_pd(kC1), c2 = _mm512_set1_pd(kC2), c3 = _mm512_set1_pd(kC3);
+  const double *sxp = s.x, *syp = s.y, *szp = s.z, *qxp = s.qx, *qyp = s.qy, *qzp = s.qz;
+  const int n = s.n;
+  for (int j = 0; j < n; ++j) {
+    const __m512d sx = _mm512_set1_pd(sxp[j]), sy = _mm512_set1_pd(syp[j]), sz = _mm512_set1_pd(szp[j]);
+    const __m512d qx = _mm512_set1_pd(qxp[j]), qy = _mm512_set1_pd(qyp[j]), qz = _mm512_set1_pd(qzp[j]);
+    for (int b = 0; b < B; ++b) {
+      const __m512d dx = _mm512_sub_pd(X[b], sx);
+      const __m512d dy = _mm512_sub_pd(Y[b], sy);
+      const __m512d dz = _mm512_sub_pd(Z[b], sz);
+      const __m512d r2 = _mm512_fmadd_pd(dz, dz, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dx, dx)));
+      // Lanes with r2 == 0 get 1/r = 0; unordered (NaN) lanes stay in so that NaN propagates.
+      const __mmask8 k = _mm512_cmp_pd_mask(r2, zero, _CMP_NEQ_UQ);
+      __m512d y;
+      if constexpr (kNewton) {
+        y = _mm512_maskz_rsqrt14_pd(k, r2);
+        const __m512d e = _mm512_fnmadd_pd(_mm512_mul_pd(r2, y), y, one);
+        const __m512d p = _mm512_fmadd_pd(_mm512_fmadd_pd(e, c3, c2), e, c1);
+        y = _mm512_fmadd_pd(_mm512_mul_pd(e, p), y, y);
+      } else {
+        y = _mm512_maskz_div_pd(k, one, _mm512_sqrt_pd(r2));
+      }
+      const __m512d rq = _mm512_fmadd_pd(dz, qz, _mm512_fmadd_pd(dy, qy, _mm512_mul_pd(dx, qx)));
+      const __m512d s2 = _mm512_mul_pd(rq, _mm512_mul_pd(y, y));
+      // u += (q + r (r·q)/r²) / r
+      UX[b] = _mm512_fmadd_pd(y, _mm512_fmadd_pd(dx, s2, qx), UX[b]);
+      UY[b] = _mm512_fmadd_pd(y, _mm512_fmadd_pd(dy, s2, qy), UY[b]);
+      UZ[b] = _mm512_fmadd_pd(y, _mm512_fmadd_pd(dz, s2, qz), UZ[b]);
+    }
+  }
+  for (int b = 0; b < B; ++b) {
+    _mm512_storeu_pd(ux + kLanes * b, UX[b]);
+    _mm512_storeu_pd(uy + kLanes * b, UY[b]);
+    _mm512_storeu_pd(uz + kLanes * b, UZ[b]);
+  }
+}
+
+#elif defined(__AVX2__) && defined(__FMA__)
+constexpr int kLanes = 4;
+constexpr const char* kIsa = "avx2";
+
+template <int B, bool kNewton>
+inline void tile(const double* tx, const double* ty, const double* tz, const Sources& s, double* ux, double* uy,
+                 double* uz) {
+  __m256d X[B], Y[B], Z[B], UX[B], UY[B], UZ[B];
+  for (int b = 0; b < B; ++b) {
+    X[b] = _mm256_loadu_pd(tx + kLanes * b);
+    Y[b] = _mm256_loadu_pd(ty + kLanes * b);
+    Z[b] = _mm256_loadu_pd(tz + kLanes * b);
+    UX[b] = _mm256_setzero_pd();
+    UY[b] = _mm256_setzero_pd();
+    UZ[b] = _mm256_setzero_pd();
+  }
+  const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
+  const __m256d c1 = _mm256_set1_pd(kC1), c2 = _mm256_set1_pd(kC2), c3 = _mm256_set1_pd(kC3),
+                c4 = _mm256_set1_pd(kC4);
+  const int n = s.n;
+  for (int j = 0; j < n; ++j) {
+    const __m256d sx = _mm256_broadcast_sd(s.x + j), sy = _mm256_broadcast_sd(s.y + j),
+                  sz = _mm256_broadcast_sd(s.z + j);
+    const __m256d qx = _mm256_broadcast_sd(s.qx + j), qy = _mm256_broadcast_sd(s.qy + j),
+                  qz = _mm256_broadcast_sd(s.qz + j);
+    for (int b = 0; b < B; ++b) {
+      const __m256d dx = _mm256_sub_pd(X[b], sx);
+      const __m256d dy = _mm256_sub_pd(Y[b], sy);
+      const __m256d dz = _mm256_sub_pd(Z[b], sz);
+      const __m256d r2 = _mm256_fmadd_pd(dz, dz, _mm256_fmadd_pd(dy, dy, _mm256_mul_pd(dx, dx)));
+      const __m256d keep = _mm256_cmp_pd(r2, zero, _CMP_NEQ_UQ);
+      __m256d y;
+      if constexpr (kNewton) {
+        // Single-precision estimate (r2 within float range for capsule geometries), then one step.
+        y = _mm256_cvtps_pd(_mm_rsqrt_ps(_mm256_cvtpd_ps(r2)));
+        y = _mm256_and_pd(y, keep);
+        const __m256d e = _mm256_fnmadd_pd(_mm256_mul_pd(r2, y), y, one);
+        __m256d p = _mm256_fmadd_pd(_mm256_fmadd_pd(e, c4, c3), e, c2);
+        p = _mm256_fmadd_pd(p, e, c1);
+        y = _mm256_fmadd_pd(_mm256_mul_pd(e, p), y, y);
+      } else {
+        y = _mm256_and_pd(_mm256_div_pd(one, _mm256_sqrt_pd(r2)), keep);
+      }
+      const __m256d rq = _mm256_fmadd_pd(dz, qz, _mm256_fmadd_pd(dy, qy, _mm256_mul_pd(dx, qx)));
+      const __m256d s2 = _mm256_mul_pd(rq, _mm256_mul_pd(y, y));
+      UX[b] = _mm256_fmadd_pd(y, _mm256_fmadd_pd(dx, s2, qx), UX[b]);
+      UY[b] = _mm256_fmadd_pd(y, _mm256_fmadd_pd(dy, s2, qy), UY[b]);
+      UZ[b] = _mm256_fmadd_pd(y, _mm256_fmadd_pd(dz, s2, qz), UZ[b]);
+    }
+  }
+  for (int b = 0; b < B; ++b) {
+    _mm256_storeu_pd(ux + kLanes * b, UX[b]);
+    _mm256_storeu_pd(uy + kLanes * b, UY[b]);
+    _mm256_storeu_pd(uz + kLanes * b, UZ[b]);
+  }
+}
+
+#else
+constexpr int kLanes = 8;
+constexpr const char* kIsa = "portable";
+
+// Portable: the same tile structure, lanes as a short inner loop the compiler vectorises.
+template <int B, bool kNewton>
+inline void tile(const double* tx, const double* ty, const double* tz, const Sources& s, double* ux, double* uy,
+                 double* uz) {
+  constexpr int W = kLanes * B;
+  double ax[W] = {}, ay[W] = {}, az[W] = {};
+  for (int j = 0; j < s.n; ++j) {
+    const double sx = s.x[j], sy = s.y[j], sz = s.z[j], qx = s.qx[j], qy = s.qy[j], qz = s.qz[j];
+#pragma omp simd
+    for (int l = 0; l < W; ++l) {
+      const double dx = tx[l] - sx, dy = ty[l] - sy, dz = tz[l] - sz;
+      const double r2 = dx * dx + dy * dy + dz * dz;
+      const double y = r2 == 0.0 ? 0.0 : 1.0 / std::sqrt(r2);
+      const double s2 = (dx * qx + dy * qy + dz * qz) * y * y;
+      ax[l] += y * (qx + dx * s2);
+      ay[l] += y * (qy + dy * s2);
+      az[l] += y * (qz + dz * s2);
+    }
+  }
+  for (int l = 0; l < W; ++l) {
+    ux[l] = ax[l];
+    uy[l] = ay[l];
+    uz[l] = az[l];
+  }
+}
+#endif
+
+template <int B, bool kNewton>
+void run_tiles(const Targets& t, const Sources& s, const Result& u) {
+  constexpr int W = kLanes * B;
+  const int ntiles = (t.n + W - 1) / W;
+#pragma omp parallel for schedule(static)
+  for (int it = 0; it < ntiles; ++it) {
+    const int i0 = it * W;
+    if (i0 + W <= t.n) {
+      tile<B, kNewton>(t.x + i0, t.y + i0, t.z + i0, s, u.x + i0, u.y + i0, u.z + i0);
+    } else {
+      // Partial last tile: pad with copies of the last target, keep only the valid lanes.
+      alignas(64) double bx[W], by[W], bz[W], ox[W], oy[W], oz[W];
+      for (int l = 0; l < W; ++l) {
+        const int i = std::min(i0 + l, t.n - 1);
+        bx[l] = t.x[i];
+        by[l] = t.y[i];
+        bz[l] = t.z[i];
+      }
+      tile<B, kNewton>(bx, by, bz, s, ox, oy, oz);
+      for (int l = 0; i0 + l < t.n; ++l) {
+        u.x[i0 + l] = ox[l];
+        u.y[i0 + l] = oy[l];
+        u.z[i0 + l] = oz[l];
+      }
+    }
+  }
+}
+
+template <bool kNewton>
+void dispatch_block(const Targets& t, const Sources& s, const Result& u, int block) {
+  switch (block) {
+    case 1: run_tiles<1, kNewton>(t, s, u); break;
+    case 2: run_tiles<2, kNewton>(t, s, u); break;
+    case 3: run_tiles<3, kNewton>(t, s, u); break;
+    case 4: run_tiles<4, kNewton>(t, s, u); break;
+    default: throw std::invalid_argument("stokes kernel: block must be 1..4, got " + std::to_string(block));
+  }
+}
+
+}  // namespace
+
+void sum_fast(const Targets& t, const Sources& s, const Result& u, const FastConfig& config) {
+  if (t.n <= 0) return;
+  if (config.inv_sqrt == InvSqrt::Newton)
+    dispatch_block<true>(t, s, u, config.block);
+  else
+    dispatch_block<false>(t, s, u, config.block);
+}
+
+void sum_plain(const Targets& t, const Sources& s, const Result& u) {
+  const int nt = t.n, ns = s.n;
+  const double *sx = s.x, *sy = s.y, *sz = s.z, *qx = s.qx, *qy = s.qy, *qz = s.qz;
+#pragma omp parallel for schedule(static)
+  for (int i = 0; i < nt; ++i) {
+    const double x0 = t.x[i], y0 = t.y[i], z0 = t.z[i];
+    double ax = 0.0, ay = 0.0, az = 0.0;
+#pragma omp simd reduction(+ : ax, ay, az)
+    for (int j = 0; j < ns; ++j) {
+      const double dx = x0 - sx[j], dy = y0 - sy[j], dz = z0 - sz[j];
+      const double r2 = dx * dx + dy * dy + dz * dz;
+      const double inv = r2 == 0.0 ? 0.0 : 1.0 / std::sqrt(r2);
+      const double sc = (dx * qx[j] + dy * qy[j] + dz * qz[j]) * inv * inv * inv;
+      ax += qx[j] * inv + dx * sc;
+      ay += qy[j] * inv + dy * sc;
+      az += qz[j] * inv + dz * sc;
+    }
+    u.x[i] = ax;
+    u.y[i] = ay;
+    u.z[i] = az;
+  }
+}
+
+const char* kernel_isa() { return kIsa; }
+
+int simd_width() { return kLanes; }
+
+}  // namespace capsim::stokes::kernel

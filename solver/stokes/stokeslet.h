@@ -1,0 +1,118 @@
+#pragma once
+/// @file
+/// @brief Stokeslet sums, the hot loop of the boundary-integral flow (DESIGN.md §3, issue 6 §1).
+///
+/// For targets x0_i and sources (x_j, w_j) this computes, for every target,
+///     u_i = Σ_j J(x0_i, x_j) · w_j,     J = I/r + r r/r³,  r = x0_i − x_j,
+/// where w_j is the already weighted load of a quadrature point (quadrature weight × surface Jacobian × q).
+/// A source at zero distance from a target contributes nothing (masked lane); a NaN coordinate propagates.
+///
+/// Two implementations of the same sum:
+///  - sum_fast: targets in SIMD lanes, one source broadcast at a time, several target vectors per tile
+///    (register blocking), OpenMP static schedule over target tiles; 1/r from the hardware reciprocal
+///    square-root estimate refined by one high-order Newton (Householder) step to full double accuracy.
+///    The instruction set is chosen at compile time: AVX-512F, else AVX2+FMA, else a portable loop that
+///    the compiler vectorises (see kernel_isa()).
+///  - sum_plain: the reference, a straightforward `#pragma omp simd` loop over sources with 1/sqrt(r²)
+///    and a division. Used to verify the fast kernel and as the baseline of the benchmarks.
+/// Both overwrite u; both are OpenMP-parallel over targets (they are not meant to be called from inside a
+/// parallel region; if they are, they run on the calling thread).
+
+#include <cstddef>
+#include <cstdlib>
+#include <new>
+#include <vector>
+
+namespace capsim::stokes {
+
+/// @brief Minimal 64-byte aligned allocator so that SoA arrays start on a cache line / vector boundary.
+template <class T>
+struct AlignedAllocator {
+  using value_type = T;
+  static constexpr std::size_t kAlign = 64;
+  AlignedAllocator() noexcept = default;
+  template <class U>
+  AlignedAllocator(const AlignedAllocator<U>&) noexcept {}
+  T* allocate(std::size_t n) {
+    const std::size_t bytes = ((n * sizeof(T) + kAlign - 1) / kAlign) * kAlign;
+    void* p = std::aligned_alloc(kAlign, bytes == 0 ? kAlign : bytes);
+    if (p == nullptr) throw std::bad_alloc();
+    return static_cast<T*>(p);
+  }
+  void deallocate(T* p, std::size_t) noexcept { std::free(p); }
+  template <class U>
+  bool operator==(const AlignedAllocator<U>&) const noexcept { return true; }
+};
+
+/// @brief A std::vector of doubles aligned to 64 bytes.
+using AlignedVector = std::vector<double, AlignedAllocator<double>>;
+
+namespace kernel {
+
+/// @brief Target positions, structure of arrays (n entries each; no padding required).
+struct Targets {
+  const double* x = nullptr;
+  const double* y = nullptr;
+  const double* z = nullptr;
+  int n = 0;
+};
+
+/// @brief Source positions and weighted loads, structure of arrays (n entries each). Padding entries, if
+/// any, must carry a zero load.
+struct Sources {
+  const double* x = nullptr;
+  const double* y = nullptr;
+  const double* z = nullptr;
+  const double* qx = nullptr;
+  const double* qy = nullptr;
+  const double* qz = nullptr;
+  int n = 0;
+};
+
+/// @brief Output, one entry per target (n = Targets::n), overwritten.
+struct Result {
+  double* x = nullptr;
+  double* y = nullptr;
+  double* z = nullptr;
+};
+
+/// @brief How the fast kernel computes 1/r.
+enum class InvSqrt {
+  Newton,   ///< hardware estimate (rsqrt14 / rsqrtps) + one high-order Newton step (default)
+  SqrtDiv,  ///< 1/sqrt(r²) with the vector sqrt and division instructions
+};
+
+/// @brief Tuning of the fast kernel (defaults = the measured best on the development machine).
+struct FastConfig {
+  int block = 3;                        ///< target vectors per tile (1..4): register blocking
+  InvSqrt inv_sqrt = InvSqrt::Newton;   ///< see InvSqrt
+};
+
+/// @brief The fast kernel (see the file comment). u is overwritten.
+void sum_fast(const Targets& t, const Sources& s, const Result& u, const FastConfig& config = {});
+
+/// @brief The reference `omp simd` loop (sources in lanes). u is overwritten.
+void sum_plain(const Targets& t, const Sources& s, const Result& u);
+
+/// @brief Alias of sum_plain, the loop used to verify sum_fast.
+inline void verify(const Targets& t, const Sources& s, const Result& u) { sum_plain(t, s, u); }
+
+/// @brief Instruction set of sum_fast in this build: "avx512", "avx2" or "portable".
+const char* kernel_isa();
+
+/// @brief Number of doubles per SIMD vector of sum_fast (8, 4, or 8 for the portable loop).
+int simd_width();
+
+/// @brief J(x0, x)·q for one pair, r = x0 − x (zero if r = 0). Scalar reference, accumulates into out.
+inline void add_stokeslet(double rx, double ry, double rz, double qx, double qy, double qz, double out[3]) {
+  const double r2 = rx * rx + ry * ry + rz * rz;
+  if (r2 == 0.0) return;
+  const double inv = 1.0 / __builtin_sqrt(r2);
+  const double s = (rx * qx + ry * qy + rz * qz) * inv * inv * inv;
+  out[0] += qx * inv + rx * s;
+  out[1] += qy * inv + ry * s;
+  out[2] += qz * inv + rz * s;
+}
+
+}  // namespace kernel
+}  // namespace capsim::stokes

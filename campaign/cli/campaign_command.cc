@@ -1,11 +1,122 @@
-// Placeholder until the campaign sub-command lands; replaced by its real implementation.
+// `capsim campaign run|status`: the campaign manager's command line.
+#include <CLI/CLI.hpp>
+
 #include <cstdio>
+#include <exception>
+#include <map>
+#include <string>
+#include <vector>
 
 #include "campaign/cli/commands.h"
+#include "campaign/common/bad_input.h"
+#include "campaign/grid/decimal.h"
+#include "campaign/query/table_output.h"
+#include "campaign/scheduler/campaign_runner.h"
+#include "campaign/store/store.h"
 
 namespace capsim::cli {
-int campaign_command(const std::vector<std::string>&) {
-  std::fprintf(stderr, "capsim: 'campaign' is not available in this build yet\n");
-  return kExitBadInput;
+
+namespace {
+
+using campaign::BadInput;
+
+int status(const std::string& db_path, const std::string& name) {
+  auto store = campaign::Store::open_readonly(db_path);
+  auto& db = store->db();
+  campaign::Stmt camps(db, "SELECT campaign_id, name, updated_at FROM campaigns WHERE (?1 = '' OR name = ?1) "
+                           "ORDER BY campaign_id");
+  camps.bind(1, name);
+  int shown = 0;
+  while (camps.step()) {
+    ++shown;
+    const auto id = camps.integer(0);
+    std::printf("campaign '%s' (last run %s)\n", camps.text(1).c_str(), camps.text(2).c_str());
+    campaign::Stmt counts(db, "SELECT c.status, count(*), sum(cc.origin='adaptive') FROM cases c JOIN campaign_cases cc "
+                              "ON cc.case_id=c.case_id WHERE cc.campaign_id=? GROUP BY c.status");
+    counts.bind(1, id);
+    std::int64_t total = 0, adaptive = 0;
+    std::string line;
+    std::map<std::string, std::int64_t> by;
+    while (counts.step()) {
+      by[counts.text(0)] = counts.integer(1);
+      total += counts.integer(1);
+      adaptive += counts.integer(2);
+    }
+    std::printf("  %lld cases (%lld added by adaptive refinement): done %lld, unstable %lld, failed %lld, running %lld, "
+                "queued %lld\n",
+                (long long)total, (long long)adaptive, (long long)by["done"], (long long)by["unstable"],
+                (long long)by["failed"], (long long)by["running"], (long long)by["queued"]);
+    campaign::Stmt bad(db, "SELECT c.case_id, c.law, c.aspect_ratio, c.capillary_number, c.status, "
+                           "coalesce(c.error,'') FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id "
+                           "WHERE cc.campaign_id=? AND (c.status IN ('failed','unstable','running') OR "
+                           "(c.status='queued' AND c.attempts>0)) ORDER BY c.status, c.law, c.aspect_ratio, "
+                           "c.capillary_number LIMIT 50");
+    bad.bind(1, id);
+    while (bad.step()) {
+      std::string err = bad.text(5);
+      if (err.size() > 160) err = err.substr(0, 157) + "...";
+      std::printf("  %-8s %s  %s a/b=%s Ca=%s  %s\n", bad.text(4).c_str(), bad.text(0).c_str(), bad.text(1).c_str(),
+                  campaign::canonical_double(*bad.real(2)).c_str(), campaign::canonical_double(*bad.real(3)).c_str(),
+                  err.c_str());
+    }
+    campaign::Stmt tr(db, "SELECT law, aspect_ratio, CASE WHEN skalak_C < 0 THEN NULL ELSE skalak_C END AS skalak_C, "
+                          "mesh_level, n_samples, ca_star_low, ca_star_high, ca_h, ca_h_low, ca_h_high, method, note "
+                          "FROM transitions WHERE campaign_id=? ORDER BY law, aspect_ratio");
+    tr.bind(1, id);
+    auto t = campaign::query_table(db, tr);
+    if (!t.rows.empty()) std::printf("%s", campaign::render(t, campaign::Format::kMarkdown).c_str());
+  }
+  if (shown == 0) {
+    if (!name.empty()) throw BadInput(db_path + ": no campaign named '" + name + "'");
+    std::printf("no campaign in %s\n", db_path.c_str());
+  }
+  return 0;
 }
+
+}  // namespace
+
+int campaign_command(const std::vector<std::string>& args) {
+  CLI::App app{"capsim campaign: run a study (grid of cases) into a SQLite database, resumably", "capsim campaign"};
+  app.require_subcommand(1);
+  campaign::RunOptions opt;
+  auto* run = app.add_subcommand("run", "expand the campaign, run what is not done yet, resume after interruptions");
+  run->add_option("campaign", opt.campaign_file, "campaign TOML file (see schemas/campaign_keys.md)")->required();
+  run->add_option("--db", opt.db_path, "SQLite results database (created if missing)")->required();
+  run->add_option("--jobs,-j", opt.jobs, "concurrent worker processes (default: cores / threads-per-job)");
+  run->add_option("--threads-per-job,-t", opt.threads_per_job, "threads per worker (default: cores / jobs)");
+  run->add_flag("--dry-run", opt.dry_run, "list what would run and why, change nothing");
+  run->add_flag("--retry-failed", opt.retry_failed, "run failed cases again");
+  run->add_option("--runs-dir", opt.runs_dir, "folder of the case folders (default: DB.runs)");
+  run->add_option("--order", opt.order, "longest (estimated cost first, default) or grid");
+  run->add_option("--grace", opt.grace_s, "seconds workers get to checkpoint after SIGINT/SIGTERM (default 120)");
+  run->add_option("--worker", opt.worker, "worker executable (default: $CAPSIM_WORKER, else this capsim)")
+      ->group("");  // hidden: for tests and alternative workers
+
+  std::string status_db, status_name;
+  auto* st = app.add_subcommand("status", "counts per status, failures, transitions of each campaign");
+  st->add_option("--db", status_db, "SQLite results database")->required();
+  st->add_option("--campaign", status_name, "only this campaign");
+
+  std::vector<std::string> rev(args.rbegin(), args.rend());
+  try {
+    app.parse(rev);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::fprintf(stderr, "capsim campaign: %s (see capsim campaign --help)\n", e.what());
+    return kExitBadInput;
+  }
+  try {
+    if (*run) {
+      if (opt.jobs < 0 || opt.threads_per_job < 0 || (run->count("--jobs") && opt.jobs == 0) ||
+          (run->count("--threads-per-job") && opt.threads_per_job == 0))
+        throw BadInput("--jobs and --threads-per-job must be >= 1");
+      return campaign::run_campaign(opt);
+    }
+    return status(status_db, status_name);
+  } catch (const BadInput& e) {
+    std::fprintf(stderr, "capsim campaign: error: %s\n", e.what());
+    return kExitBadInput;
+  }
+}
+
 }  // namespace capsim::cli

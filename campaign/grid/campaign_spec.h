@@ -1,0 +1,55 @@
+#pragma once
+/// @file
+/// @brief A campaign file (TOML) parsed and validated strictly; see schemas/campaign_keys.md.
+
+#include <string>
+#include <vector>
+
+#include "campaign/grid/case_keys.h"
+#include "campaign/grid/case_params.h"
+
+namespace capsim::campaign {
+
+/// @brief One axis of a [[grid]] block: a dotted case key and its values (already validated).
+struct GridAxis {
+  std::string key;            ///< dotted case key, e.g. "flow.capillary_number"
+  std::vector<Value> values;  ///< distinct values in file order
+};
+
+/// @brief One [[grid]] block: the Cartesian product of its axes.
+struct GridBlock {
+  std::vector<GridAxis> axes;  ///< in file order
+};
+
+/// @brief The [analysis] section.
+struct AnalysisSpec {
+  double d12_threshold = 0.05;  ///< min D12 below this marks the transition band (Ca*)
+  bool adaptive = false;        ///< add cases automatically to bracket Ca* edges and CaH
+  double ca_tolerance = 0.005;  ///< adaptive mode stops when brackets are narrower than this
+  int max_cases = 200;          ///< adaptive mode never adds more than this many cases per campaign
+  int max_rounds = 10;          ///< adaptive refinement rounds
+};
+
+/// @brief A validated campaign.
+struct CampaignSpec {
+  std::string name;         ///< [campaign] name (required; identifies the campaign in the database)
+  std::string description;  ///< [campaign] description
+  std::string source;       ///< file it was read from
+  CaseParams defaults;      ///< case keys shared by all cases ([defaults] over the built-in defaults)
+  std::vector<GridBlock> grids;  ///< [[grid]] blocks
+  AnalysisSpec analysis;    ///< [analysis]
+  /// @brief Canonical JSON of the whole specification (stored with the campaign).
+  std::string to_json() const;
+};
+
+/// @brief Parses campaign text; @p source names it in messages. @throws BadInput ("SOURCE: key: problem").
+CampaignSpec parse_campaign(const std::string& text, const std::string& source);
+
+/// @brief Reads and parses a campaign file. @throws BadInput (missing file, syntax, validation).
+CampaignSpec load_campaign_file(const std::string& path);
+
+/// @brief The cases of a campaign: union of its grid blocks over the defaults, duplicates (same identity)
+/// removed, in first-appearance order.
+std::vector<CaseParams> expand_grid(const CampaignSpec& spec);
+
+}  // namespace capsim::campaign

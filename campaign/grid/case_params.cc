@@ -1,0 +1,105 @@
+#include "campaign/grid/case_params.h"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "campaign/common/bad_input.h"
+#include "campaign/grid/sha256.h"
+#include "capsim/version.h"
+
+namespace capsim::campaign {
+
+std::string solver_version() { return kGitCommit; }
+
+CaseParams CaseParams::defaults() {
+  CaseParams p;
+  for (const auto& k : case_keys())
+    if (k.fallback) p.values_[k.name] = *k.fallback;
+  return p;
+}
+
+CaseParams CaseParams::from_json(const std::string& json_text) {
+  CaseParams p;
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(json_text);
+  } catch (const std::exception& e) {
+    throw BadInput(std::string("case parameters are not valid JSON: ") + e.what());
+  }
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const CaseKey* key = find_case_key(it.key());
+    if (!key) throw BadInput("case parameters: unknown key '" + it.key() + "'");
+    const auto& v = it.value();
+    if (v.is_boolean()) p.values_[it.key()] = v.get<bool>();
+    else if (v.is_number_integer() && key->type != KeyType::kFloat && key->type != KeyType::kFloatOrAuto)
+      p.values_[it.key()] = v.get<std::int64_t>();
+    else if (v.is_number()) p.values_[it.key()] = v.get<double>();
+    else if (v.is_string()) p.values_[it.key()] = v.get<std::string>();
+    else throw BadInput("case parameters: bad value for '" + it.key() + "'");
+  }
+  return p;
+}
+
+namespace {
+double num(const std::map<std::string, Value>& m, const std::string& k, double fallback) {
+  auto it = m.find(k);
+  if (it == m.end()) return fallback;
+  if (auto* d = std::get_if<double>(&it->second)) return *d;
+  if (auto* i = std::get_if<std::int64_t>(&it->second)) return static_cast<double>(*i);
+  return fallback;
+}
+}  // namespace
+
+double CaseParams::capillary_number() const { return num(values_, "flow.capillary_number", 0.3); }
+double CaseParams::aspect_ratio() const { return num(values_, "capsule.aspect_ratio", 2.0); }
+double CaseParams::skalak_C() const { return num(values_, "capsule.skalak_C", 1.0); }
+int CaseParams::mesh_level() const { return static_cast<int>(num(values_, "mesh.level", 3)); }
+double CaseParams::t_end() const { return num(values_, "time.t_end", 60.0); }
+std::string CaseParams::law() const {
+  auto it = values_.find("capsule.law");
+  if (it == values_.end()) return "skalak";
+  return std::get<std::string>(it->second);
+}
+
+std::string CaseParams::canonical() const {
+  const bool neo = law() == "neo-hookean";
+  std::string out;
+  for (const auto& [k, v] : values_) {
+    const CaseKey* key = find_case_key(k);
+    if (key && !key->in_identity) continue;
+    if (neo && k == "capsule.skalak_C") continue;
+    // Numbers are canonical regardless of how they were typed: 2 and 2.0 are the same aspect ratio.
+    Value canon = v;
+    if (key && (key->type == KeyType::kFloat || key->type == KeyType::kFloatOrAuto))
+      if (auto* i = std::get_if<std::int64_t>(&v)) canon = static_cast<double>(*i);
+    out += k + "=" + value_to_text(canon) + "\n";
+  }
+  return out;
+}
+
+std::string CaseParams::identity(const std::string& version) const {
+  return sha256_hex(canonical() + "solver=" + version + "\n").substr(0, 16);
+}
+
+std::string CaseParams::to_json() const {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [k, v] : values_) std::visit([&](const auto& x) { j[k] = x; }, v);
+  return j.dump();
+}
+
+std::string CaseParams::to_toml() const {
+  std::map<std::string, std::string> sections;
+  for (const auto& [k, v] : values_) {
+    auto dot = k.find('.');
+    sections[k.substr(0, dot)] += k.substr(dot + 1) + " = " + value_to_text(v) + "\n";
+  }
+  std::string out = "# Written by capsim campaign: one case of a campaign.\n";
+  for (const auto& [s, body] : sections) out += "\n[" + s + "]\n" + body;
+  return out;
+}
+
+double CaseParams::estimated_cost() const {
+  return t_end() * std::pow(2.0, 5.0 * mesh_level()) / std::max(capillary_number(), 1e-6);
+}
+
+}  // namespace capsim::campaign

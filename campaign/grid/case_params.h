@@ -1,0 +1,58 @@
+#pragma once
+/// @file
+/// @brief The fully resolved parameters of one case and its identity.
+
+#include <map>
+#include <string>
+
+#include "campaign/grid/case_keys.h"
+
+namespace capsim::campaign {
+
+/// @brief Solver version that enters case identities: capsim::kGitCommit as built (a "-dirty" suffix is
+/// kept, so results of a modified tree never mix with those of the clean commit).
+std::string solver_version();
+
+/// @brief All case keys of one case (defaults filled in), as a sorted map of dotted key -> value.
+class CaseParams {
+ public:
+  /// @brief A case holding every key that has a default.
+  static CaseParams defaults();
+  /// @brief Rebuilds a case from to_json() text. @throws BadInput on unknown keys or wrong types.
+  static CaseParams from_json(const std::string& json_text);
+
+  /// @brief Sets one key (the caller has validated type and range).
+  void set(const std::string& key, Value v) { values_[key] = std::move(v); }
+  /// @brief All values, sorted by key.
+  const std::map<std::string, Value>& values() const { return values_; }
+
+  /// @brief flow.capillary_number.
+  double capillary_number() const;
+  /// @brief capsule.aspect_ratio.
+  double aspect_ratio() const;
+  /// @brief capsule.law.
+  std::string law() const;
+  /// @brief capsule.skalak_C.
+  double skalak_C() const;
+  /// @brief mesh.level.
+  int mesh_level() const;
+  /// @brief time.t_end.
+  double t_end() const;
+
+  /// @brief Canonical text of the parameters that change results: sorted "key=value" lines, keys with
+  /// in_identity=false left out, capsule.skalak_C left out for the neo-Hookean law.
+  std::string canonical() const;
+  /// @brief Case identity: first 16 hex digits of SHA-256(canonical() + "solver=" + version).
+  std::string identity(const std::string& version) const;
+  /// @brief JSON object of all values (dotted keys).
+  std::string to_json() const;
+  /// @brief A case file for `capsim run` (TOML sections).
+  std::string to_toml() const;
+  /// @brief Relative cost estimate, for longest-first ordering: t_end * (2^level)^5 / Ca.
+  double estimated_cost() const;
+
+ private:
+  std::map<std::string, Value> values_;
+};
+
+}  // namespace capsim::campaign

@@ -1,0 +1,92 @@
+#include "campaign/query/table_output.h"
+
+#include <nlohmann/json.hpp>
+
+#include "campaign/common/bad_input.h"
+#include "campaign/grid/decimal.h"
+
+namespace capsim::campaign {
+
+Format parse_format(const std::string& s) {
+  if (s == "md" || s == "markdown") return Format::kMarkdown;
+  if (s == "csv") return Format::kCsv;
+  if (s == "json") return Format::kJson;
+  throw BadInput("--format: expected md, csv or json, got '" + s + "'");
+}
+
+Table query_table(Db&, Stmt& stmt) {
+  Table t;
+  for (int c = 0; c < stmt.columns(); ++c) t.columns.push_back(stmt.column_name(c));
+  while (stmt.step()) {
+    std::vector<SqlValue> row;
+    for (int c = 0; c < stmt.columns(); ++c) row.push_back(stmt.column(c));
+    t.rows.push_back(std::move(row));
+  }
+  return t;
+}
+
+std::string cell_text(const SqlValue& v) {
+  if (std::holds_alternative<std::nullptr_t>(v)) return "";
+  if (auto* i = std::get_if<std::int64_t>(&v)) return std::to_string(*i);
+  if (auto* d = std::get_if<double>(&v)) return canonical_double(*d);
+  return std::get<std::string>(v);
+}
+
+std::string render(const Table& t, Format f) {
+  std::string out;
+  if (f == Format::kJson) {
+    nlohmann::ordered_json arr = nlohmann::ordered_json::array();
+    for (const auto& row : t.rows) {
+      nlohmann::ordered_json o = nlohmann::ordered_json::object();
+      for (std::size_t c = 0; c < t.columns.size(); ++c) {
+        const auto& v = row[c];
+        if (std::holds_alternative<std::nullptr_t>(v)) o[t.columns[c]] = nullptr;
+        else if (auto* i = std::get_if<std::int64_t>(&v)) o[t.columns[c]] = *i;
+        else if (auto* d = std::get_if<double>(&v)) o[t.columns[c]] = *d;
+        else o[t.columns[c]] = std::get<std::string>(v);
+      }
+      arr.push_back(std::move(o));
+    }
+    return arr.dump(2) + "\n";
+  }
+  if (f == Format::kCsv) {
+    auto quote = [](const std::string& s) {
+      if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+      std::string q = "\"";
+      for (char c : s) {
+        if (c == '"') q.push_back('"');
+        q.push_back(c);
+      }
+      return q + "\"";
+    };
+    for (std::size_t c = 0; c < t.columns.size(); ++c) out += (c ? "," : "") + quote(t.columns[c]);
+    out += "\n";
+    for (const auto& row : t.rows) {
+      for (std::size_t c = 0; c < row.size(); ++c) out += (c ? "," : "") + quote(cell_text(row[c]));
+      out += "\n";
+    }
+    return out;
+  }
+  auto esc = [](std::string s) {
+    std::string r;
+    for (char c : s) {
+      if (c == '|') r += "\\|";
+      else if (c == '\n') r += " ";
+      else r.push_back(c);
+    }
+    return r;
+  };
+  out += "|";
+  for (const auto& c : t.columns) out += " " + esc(c) + " |";
+  out += "\n|";
+  for (std::size_t c = 0; c < t.columns.size(); ++c) out += "---|";
+  out += "\n";
+  for (const auto& row : t.rows) {
+    out += "|";
+    for (const auto& v : row) out += " " + esc(cell_text(v)) + " |";
+    out += "\n";
+  }
+  return out;
+}
+
+}  // namespace capsim::campaign

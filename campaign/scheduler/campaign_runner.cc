@@ -1,0 +1,420 @@
+#include "campaign/scheduler/campaign_runner.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/file.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <thread>
+
+#include "campaign/analysis/transitions.h"
+#include "campaign/common/bad_input.h"
+#include "campaign/grid/campaign_spec.h"
+#include "campaign/grid/decimal.h"
+#include "campaign/scheduler/progress.h"
+#include "campaign/scheduler/worker_process.h"
+#include "campaign/store/store.h"
+
+namespace capsim::campaign {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+volatile sig_atomic_t g_stop_signal = 0;
+volatile sig_atomic_t g_stop_count = 0;
+
+void on_stop_signal(int sig) {
+  g_stop_signal = sig;
+  g_stop_count = g_stop_count + 1;
+}
+
+/// Installs SIGINT/SIGTERM handlers for the lifetime of a run and restores the old ones.
+class SignalGuard {
+ public:
+  SignalGuard() {
+    g_stop_signal = 0;
+    g_stop_count = 0;
+    struct sigaction sa {};
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+    struct sigaction ign {};
+    ign.sa_handler = SIG_IGN;
+    sigaction(SIGPIPE, &ign, &old_pipe_);
+  }
+  ~SignalGuard() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+    sigaction(SIGPIPE, &old_pipe_, nullptr);
+  }
+
+ private:
+  struct sigaction old_int_ {}, old_term_ {}, old_pipe_ {};
+};
+
+/// One manager per database: an exclusive flock on DB.lock (released by the kernel if we die).
+class ManagerLock {
+ public:
+  explicit ManagerLock(const std::string& db_path) : path_(db_path + ".lock") {
+    fd_ = open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw BadInput(path_ + ": cannot create lock file: " + std::strerror(errno));
+    if (flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      char buf[64] = {0};
+      (void)!pread(fd_, buf, sizeof buf - 1, 0);
+      close(fd_);
+      fd_ = -1;
+      throw BadInput(db_path + ": another campaign manager is running on this database (pid " +
+                     std::string(buf[0] ? buf : "?") + ")");
+    }
+    std::string pid = std::to_string(getpid());
+    (void)!ftruncate(fd_, 0);
+    (void)!pwrite(fd_, pid.data(), pid.size(), 0);
+  }
+  ~ManagerLock() {
+    if (fd_ >= 0) close(fd_);
+  }
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+};
+
+void write_file_atomic(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << text;
+    if (!out) throw std::runtime_error(tmp + ": cannot write");
+  }
+  fs::rename(tmp, path);
+}
+
+struct Running {
+  CaseRow row;
+  std::int64_t attempt_id = 0;
+  std::chrono::steady_clock::time_point start;
+};
+
+class Runner {
+ public:
+  Runner(const RunOptions& opt, Store& store, std::int64_t campaign_id, const std::string& name, int jobs, int threads,
+         std::string runs_dir)
+      : opt_(opt), store_(store), campaign_id_(campaign_id), progress_(name), jobs_(jobs), threads_(threads),
+        runs_dir_(std::move(runs_dir)), worker_(opt.worker.empty() ? default_worker_executable() : opt.worker),
+        host_(host_name()) {}
+
+  /// Runs every queued case of the campaign; returns false if stopped by a signal.
+  bool run_queued() {
+    auto rows = store_.campaign_cases(campaign_id_);
+    std::vector<CaseRow> pending;
+    for (auto& r : rows)
+      if (r.status == "queued" && !interrupted_.count(r.case_id)) pending.push_back(r);
+    if (opt_.order == "longest")
+      std::stable_sort(pending.begin(), pending.end(),
+                       [](const CaseRow& a, const CaseRow& b) { return a.est_cost > b.est_cost; });
+    total_ = static_cast<int>(rows.size());
+    finished_ = failed_ = 0;
+    for (auto& r : rows) {
+      if (r.status == "done" || r.status == "unstable") ++finished_;
+      if (r.status == "failed") ++failed_;
+    }
+    std::reverse(pending.begin(), pending.end());  // pop_back = next case
+    bool forwarded = false;
+    std::chrono::steady_clock::time_point kill_deadline{};
+    while (!pending.empty() || !running_.empty()) {
+      if (g_stop_signal && !forwarded) {
+        forwarded = true;
+        progress_.message("capsim campaign: " + std::string(strsignal(g_stop_signal)) + ": stopping " +
+                          std::to_string(running_.size()) + " worker(s) (they checkpoint); rerun to resume");
+        for (auto& [pid, _] : running_) kill(pid, SIGTERM);
+        kill_deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                                std::chrono::duration<double>(opt_.grace_s));
+      }
+      if (forwarded && (g_stop_count > 1 || std::chrono::steady_clock::now() > kill_deadline)) {
+        for (auto& [pid, _] : running_) kill(-pid, SIGKILL);
+      }
+      reap();
+      while (!g_stop_signal && static_cast<int>(running_.size()) < jobs_ && !pending.empty()) {
+        CaseRow row = std::move(pending.back());
+        pending.pop_back();
+        start(row);
+      }
+      queued_ = static_cast<int>(pending.size());
+      progress_.show(counts());
+      if (g_stop_signal && running_.empty()) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    }
+    queued_ = static_cast<int>(pending.size());
+    progress_.show(counts(), true);
+    return g_stop_signal == 0;
+  }
+
+  void finish() { progress_.finish(); }
+  void message(const std::string& m) { progress_.message(m); }
+  int failed() const { return failed_; }
+  int interrupted() const { return static_cast<int>(interrupted_.size()); }
+
+ private:
+  ProgressCounts counts() const {
+    ProgressCounts c;
+    c.total = total_;
+    c.finished = finished_;
+    c.failed = failed_;
+    c.running = static_cast<int>(running_.size());
+    c.queued = queued_;
+    if (cost_done_ > 0 && wall_done_ > 0) {
+      double remaining = pending_cost_estimate();
+      c.eta_s = wall_done_ / cost_done_ * remaining / std::max(1, jobs_);
+    }
+    return c;
+  }
+  double pending_cost_estimate() const {
+    // Queued cost is not tracked per case here; approximate with the mean finished cost per case.
+    double mean_cost = cost_done_ / std::max(1, n_done_session_);
+    double rem = queued_ * mean_cost;
+    auto now = std::chrono::steady_clock::now();
+    for (const auto& [_, r] : running_) {
+      double expect = r.row.est_cost * wall_done_ / cost_done_;
+      double elapsed = std::chrono::duration<double>(now - r.start).count();
+      rem += std::max(0.0, expect - elapsed) * cost_done_ / wall_done_;
+    }
+    return rem;
+  }
+
+  void start(CaseRow row) {
+    if (row.out_dir.empty()) row.out_dir = runs_dir_ + "/" + row.case_id;
+    fs::create_directories(row.out_dir);
+    const std::string toml = row.out_dir + "/case.toml";
+    write_file_atomic(toml, row.params.to_toml());
+    const bool resume = row.resumable;
+    WorkerCommand cmd;
+    cmd.executable = worker_;
+    cmd.args = worker_args(toml, row.out_dir, threads_, resume);
+    cmd.stdout_path = row.out_dir + "/stdout.log";
+    cmd.stderr_path = row.out_dir + "/stderr.log";
+    cmd.threads = threads_;
+    {
+      std::ofstream err(cmd.stderr_path, std::ios::app);
+      err << "=== capsim campaign: attempt " << row.attempts + 1 << (resume ? " (resume)" : "") << " on " << host_
+          << " ===\n";
+    }
+    pid_t pid = spawn_worker(cmd);
+    Running r;
+    r.attempt_id = store_.mark_running(row.case_id, host_, pid, resume);
+    r.row = std::move(row);
+    r.start = std::chrono::steady_clock::now();
+    running_.emplace(pid, std::move(r));
+  }
+
+  void reap() {
+    while (true) {
+      int st = 0;
+      pid_t pid = waitpid(-1, &st, WNOHANG);
+      if (pid <= 0) return;
+      auto it = running_.find(pid);
+      if (it == running_.end()) continue;
+      Running r = std::move(it->second);
+      running_.erase(it);
+      WorkerOutcome out;
+      out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - r.start).count();
+      if (WIFEXITED(st)) out.exit_code = WEXITSTATUS(st);
+      else if (WIFSIGNALED(st)) out.signal = WTERMSIG(st);
+      out.last_line = last_line_of(r.row.out_dir + "/stdout.log");
+      out.stderr_tail = tail_of(r.row.out_dir + "/stderr.log", 600);
+      const std::string h5 = fs::exists(r.row.out_dir + "/case.h5") ? r.row.out_dir + "/case.h5" : "";
+      const std::string status = store_.record_outcome(r.row.case_id, r.attempt_id, out, h5, r.row.params);
+      if (status == "done" || status == "unstable") {
+        ++finished_;
+        wall_done_ += out.wall_s;
+        cost_done_ += r.row.est_cost;
+        ++n_done_session_;
+      } else if (status == "failed") {
+        ++failed_;
+        progress_.message("capsim campaign: case " + r.row.case_id + " (Ca=" +
+                          canonical_double(r.row.params.capillary_number()) + ", a/b=" +
+                          canonical_double(r.row.params.aspect_ratio()) + ", " + r.row.params.law() + ") failed: " +
+                          (out.signal ? "signal " + std::to_string(out.signal) : "exit " + std::to_string(out.exit_code)));
+      } else {
+        interrupted_.insert(r.row.case_id);
+      }
+    }
+  }
+
+  const RunOptions& opt_;
+  Store& store_;
+  std::int64_t campaign_id_;
+  Progress progress_;
+  int jobs_, threads_;
+  std::string runs_dir_, worker_, host_;
+  std::map<pid_t, Running> running_;
+  std::set<std::string> interrupted_;
+  int total_ = 0, finished_ = 0, failed_ = 0, queued_ = 0, n_done_session_ = 0;
+  double wall_done_ = 0, cost_done_ = 0;
+};
+
+/// After a manager crash: stop leftover workers, then ingest finished results or requeue.
+void recover(Store& store, const std::string& runs_dir, Runner* log) {
+  auto orphans = find_orphan_workers(runs_dir);
+  if (!orphans.empty()) {
+    if (log) log->message("capsim campaign: stopping " + std::to_string(orphans.size()) +
+                          " worker(s) left by an earlier manager");
+    stop_processes(orphans, 60);
+  }
+  for (const auto& row : store.running_cases()) {
+    const std::string line = last_line_of(row.out_dir + "/stdout.log");
+    const std::string h5 = fs::exists(row.out_dir + "/case.h5") ? row.out_dir + "/case.h5" : "";
+    const std::string status = store.recover_orphan(row.case_id, line, has_checkpoint(row.out_dir), h5, row.params);
+    if (log) log->message("capsim campaign: case " + row.case_id + " was running when the manager stopped: " +
+                          (status == "queued" ? "requeued" : "result ingested (" + status + ")"));
+  }
+}
+
+/// Adds adaptive cases; returns how many were added.
+int refine(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir) {
+  int adaptive_so_far = static_cast<int>(std::get<std::int64_t>(
+      *store.db().scalar("SELECT count(*) FROM campaign_cases WHERE origin='adaptive' AND campaign_id=" +
+                         std::to_string(campaign_id))));
+  int budget = spec.analysis.max_cases - adaptive_so_far;
+  std::vector<CaseParams> add;
+  for (auto& g : load_groups(store.db(), campaign_id)) {
+    Transition key = g.key;
+    Transition t = analyse_group(key, g.samples, spec.analysis.d12_threshold);
+    auto cas = propose_refinement(t, g.samples, spec.analysis.ca_tolerance);
+    if (cas.empty()) continue;
+    Stmt s(store.db(), "SELECT params_json FROM cases WHERE case_id=?");
+    s.bind(1, g.some_case_id);
+    if (!s.step()) continue;
+    CaseParams base = CaseParams::from_json(s.text(0));
+    for (double ca : cas) {
+      if (budget <= 0) break;
+      CaseParams p = base;
+      p.set("flow.capillary_number", ca);
+      add.push_back(p);
+      --budget;
+    }
+  }
+  if (add.empty()) return 0;
+  Transaction t(store.db());
+  int n = store.add_cases(campaign_id, add, "adaptive", runs_dir);
+  t.commit();
+  (void)n;
+  return static_cast<int>(add.size());
+}
+
+int dry_run(const RunOptions& opt, const CampaignSpec& spec, const std::vector<CaseParams>& cases) {
+  std::unique_ptr<Store> store;
+  if (fs::exists(opt.db_path)) store = Store::open_readonly(opt.db_path);
+  const std::string version = solver_version();
+  std::map<std::string, int> counts;
+  std::printf("%-16s  %-11s  %-8s  %-6s  %-5s  %s\n", "case_id", "law", "a/b", "Ca", "level", "action");
+  for (const auto& p : cases) {
+    const std::string id = p.identity(version);
+    std::string action = "run: new";
+    if (store) {
+      Stmt s(store->db(), "SELECT status, resumable, attempts, coalesce(error,'') FROM cases WHERE case_id=?");
+      s.bind(1, id);
+      if (s.step()) {
+        const std::string st = s.text(0);
+        if (st == "done" || st == "unstable") action = "skip: " + st;
+        else if (st == "failed") action = opt.retry_failed ? "run: retry failed (" + s.text(3).substr(0, 60) + ")"
+                                                           : "skip: failed (use --retry-failed)";
+        else if (st == "running") action = "run: orphaned by a stopped manager (recovered first)";
+        else if (s.integer(1)) action = "run: interrupted, resume from checkpoint";
+        else if (s.integer(2) > 0) action = "run: interrupted, restart";
+        else action = "run: queued";
+      }
+    }
+    counts[action.substr(0, action.find(':'))]++;
+    std::printf("%-16s  %-11s  %-8s  %-6s  %-5d  %s\n", id.c_str(), p.law().c_str(),
+                canonical_double(p.aspect_ratio()).c_str(), canonical_double(p.capillary_number()).c_str(),
+                p.mesh_level(), action.c_str());
+  }
+  std::printf("%zu cases: %d to run, %d to skip%s\n", cases.size(), counts["run"], counts["skip"],
+              spec.analysis.adaptive ? " (adaptive mode may add more)" : "");
+  return kRunComplete;
+}
+
+}  // namespace
+
+std::string default_runs_dir(const std::string& db_path) { return db_path + ".runs"; }
+
+int run_campaign(const RunOptions& opt) {
+  const CampaignSpec spec = load_campaign_file(opt.campaign_file);
+  const std::vector<CaseParams> cases = expand_grid(spec);
+  if (opt.order != "longest" && opt.order != "grid")
+    throw BadInput("--order: expected 'longest' or 'grid', got '" + opt.order + "'");
+  if (opt.dry_run) return dry_run(opt, spec, cases);
+
+  const int cores = std::max(1u, std::thread::hardware_concurrency());
+  int jobs = opt.jobs, threads = opt.threads_per_job;
+  if (jobs < 0 || threads < 0) throw BadInput("--jobs and --threads-per-job must be >= 1");
+  if (jobs == 0 && threads == 0) threads = 1;
+  if (jobs == 0) jobs = std::max(1, cores / threads);
+  if (threads == 0) threads = std::max(1, cores / jobs);
+
+  const fs::path db_dir = fs::absolute(opt.db_path).parent_path();
+  if (!fs::is_directory(db_dir)) throw BadInput(opt.db_path + ": folder " + db_dir.string() + " does not exist");
+  ManagerLock lock(opt.db_path);
+  auto store = Store::open_for_write(opt.db_path);
+  const std::string runs_dir =
+      fs::weakly_canonical(fs::absolute(opt.runs_dir.empty() ? default_runs_dir(opt.db_path) : opt.runs_dir)).string();
+  fs::create_directories(runs_dir);
+
+  SignalGuard signals;
+  std::int64_t campaign_id;
+  {
+    Transaction t(store->db());
+    campaign_id = store->upsert_campaign(spec);
+    store->add_cases(campaign_id, cases, "grid", runs_dir);
+    if (opt.retry_failed) store->requeue_failed(campaign_id);
+    t.commit();
+  }
+  Runner runner(opt, *store, campaign_id, spec.name, jobs, threads, runs_dir);
+  recover(*store, runs_dir, &runner);
+  runner.message("capsim campaign: '" + spec.name + "': " + std::to_string(cases.size()) + " grid cases, " +
+                 std::to_string(jobs) + " job(s) x " + std::to_string(threads) + " thread(s), database " + opt.db_path);
+
+  bool completed = runner.run_queued();
+  const std::string method = spec.analysis.adaptive ? "adaptive" : "grid";
+  if (completed && spec.analysis.adaptive) {
+    for (int round = 1; round <= spec.analysis.max_rounds && completed; ++round) {
+      int added = refine(*store, campaign_id, spec, runs_dir);
+      if (added == 0) break;
+      runner.message("capsim campaign: adaptive round " + std::to_string(round) + ": " + std::to_string(added) +
+                     " case(s) added");
+      completed = runner.run_queued();
+    }
+  }
+  runner.finish();
+  analyse_campaign(*store, campaign_id, spec.analysis.d12_threshold, method);
+  if (!completed) {
+    std::fprintf(stderr, "capsim campaign: interrupted; the database is consistent. Rerun the same command to resume.\n");
+    return kRunInterrupted;
+  }
+  if (runner.interrupted() > 0) {
+    std::fprintf(stderr, "capsim campaign: %d case(s) were interrupted from outside; rerun to resume them\n",
+                 runner.interrupted());
+    return kRunInterrupted;
+  }
+  if (runner.failed() > 0) {
+    std::fprintf(stderr, "capsim campaign: finished with %d failed case(s); see `capsim query cases --status failed "
+                         "--db %s`, rerun with --retry-failed to retry\n", runner.failed(), opt.db_path.c_str());
+    return kRunSomeFailed;
+  }
+  std::fprintf(stderr, "capsim campaign: complete\n");
+  return kRunComplete;
+}
+
+}  // namespace capsim::campaign

@@ -1,0 +1,62 @@
+#include "campaign/scheduler/progress.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+
+namespace capsim::campaign {
+
+std::string format_duration(double s) {
+  if (s < 0) return "?";
+  long t = static_cast<long>(s + 0.5);
+  char buf[64];
+  if (t >= 3600) std::snprintf(buf, sizeof buf, "%ldh%02ldm", t / 3600, (t % 3600) / 60);
+  else if (t >= 60) std::snprintf(buf, sizeof buf, "%ldm%02lds", t / 60, t % 60);
+  else std::snprintf(buf, sizeof buf, "%lds", t);
+  return buf;
+}
+
+Progress::Progress(std::string name) : name_(std::move(name)), tty_(isatty(STDERR_FILENO) == 1) {}
+
+std::string Progress::format(const ProgressCounts& c) const {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "[%s] %d/%d done, %d running, %d failed, %d queued, ETA %s", name_.c_str(),
+                c.finished, c.total, c.running, c.failed, c.queued, format_duration(c.eta_s).c_str());
+  return buf;
+}
+
+void Progress::show(const ProgressCounts& c, bool force) {
+  const auto now = std::chrono::steady_clock::now();
+  const std::string line = format(c);
+  const double since = std::chrono::duration<double>(now - last_time_).count();
+  if (tty_) {
+    if (!force && since < 0.1) return;
+    const int bar = 20;
+    int filled = c.total > 0 ? (bar * (c.finished + c.failed)) / c.total : 0;
+    std::string b(static_cast<std::size_t>(filled), '#');
+    b.resize(bar, '.');
+    std::fprintf(stderr, "\r\033[K[%s] %s", b.c_str(), line.c_str());
+    std::fflush(stderr);
+    drawn_ = true;
+  } else {
+    // Plain log: a line whenever the counts change (ETA aside), else every 30 s.
+    const std::string key = line.substr(0, line.find(", ETA"));
+    if (!force && key == last_ && since < 30) return;
+    std::fprintf(stderr, "%s\n", line.c_str());
+    last_ = key;
+  }
+  last_time_ = now;
+}
+
+void Progress::message(const std::string& text) {
+  if (tty_ && drawn_) std::fprintf(stderr, "\r\033[K");
+  std::fprintf(stderr, "%s\n", text.c_str());
+  if (tty_ && drawn_) last_time_ = {};
+}
+
+void Progress::finish() {
+  if (tty_ && drawn_) std::fprintf(stderr, "\n");
+  drawn_ = false;
+}
+
+}  // namespace capsim::campaign

@@ -1,0 +1,389 @@
+#include "campaign/store/store.h"
+
+#include <sqlite3.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <regex>
+
+#include "campaign/common/bad_input.h"
+#include "capsim/schema_sql.h"
+#include "capsim/version.h"
+
+namespace capsim::campaign {
+
+namespace {
+
+constexpr std::int64_t kApplicationId = 1129336909;  // "CPSM", see schemas/001_campaign_v1.sql
+const char* kNow = "strftime('%Y-%m-%dT%H:%M:%fZ','now')";
+
+std::int64_t as_int(const std::optional<SqlValue>& v) {
+  if (!v) return 0;
+  if (auto* i = std::get_if<std::int64_t>(&*v)) return *i;
+  return 0;
+}
+
+/// Reads the header pragmas; a non-database file fails here, before anything is written.
+void verify_header(Db& db, bool& fresh) {
+  std::int64_t app = 0, version = 0, tables = 0;
+  try {
+    app = as_int(db.scalar("PRAGMA application_id"));
+    version = as_int(db.scalar("PRAGMA user_version"));
+    tables = as_int(db.scalar("SELECT count(*) FROM sqlite_master"));
+  } catch (const DbError& e) {
+    throw BadInput(db.path() + ": not a capsim database or corrupt (" + e.what() + ")");
+  }
+  fresh = (app == 0 && version == 0 && tables == 0);
+  if (fresh) return;
+  if (app != kApplicationId)
+    throw BadInput(db.path() + ": not a capsim campaign database (application_id " + std::to_string(app) + ")");
+  const int want = Store::expected_schema_version();
+  if (version != want)
+    throw BadInput(db.path() + ": database schema version " + std::to_string(version) + ", this capsim (" +
+                   std::string(kGitCommit) + ") reads version " + std::to_string(want) +
+                   "; use a matching capsim or a new --db file");
+  std::string check;
+  try {
+    check = std::get<std::string>(db.scalar("PRAGMA quick_check").value_or(SqlValue{std::string("?")}));
+  } catch (const std::exception& e) {
+    throw BadInput(db.path() + ": database is corrupt (" + e.what() + ")");
+  }
+  if (check != "ok") throw BadInput(db.path() + ": database is corrupt (quick_check: " + check + ")");
+}
+
+std::optional<nlohmann::json> parse_result_line(const std::string& line) {
+  try {
+    auto j = nlohmann::json::parse(line);
+    if (!j.is_object() || !j.contains("status") || !j["status"].is_string()) return std::nullopt;
+    std::string s = j["status"];
+    if (s != "done" && s != "unstable") return std::nullopt;
+    return j;
+  } catch (...) {
+    return std::nullopt;
+  }
+}
+
+SqlValue jnum(const nlohmann::json& j, const char* k) {
+  if (!j.contains(k) || !j[k].is_number()) return nullptr;
+  if (j[k].is_number_integer()) return j[k].get<std::int64_t>();
+  double x = j[k].get<double>();
+  if (!std::isfinite(x)) return nullptr;
+  return x;
+}
+SqlValue jstr(const nlohmann::json& j, const char* k) {
+  if (!j.contains(k) || !j[k].is_string()) return nullptr;
+  return j[k].get<std::string>();
+}
+
+/// Returns "" if the worker's reported parameters match the case, else what differs.
+std::string mismatch(const nlohmann::json& j, const CaseParams& p) {
+  auto near = [](double a, double b) { return std::fabs(a - b) <= 1e-9 * std::max(1.0, std::fabs(b)); };
+  for (const char* k : {"capillary_number", "Ca"})
+    if (j.contains(k) && j[k].is_number() && !near(j[k].get<double>(), p.capillary_number()))
+      return std::string(k) + " " + j[k].dump();
+  if (j.contains("aspect_ratio") && j["aspect_ratio"].is_number() &&
+      !near(j["aspect_ratio"].get<double>(), p.aspect_ratio()))
+    return "aspect_ratio " + j["aspect_ratio"].dump();
+  if (j.contains("law") && j["law"].is_string() && j["law"].get<std::string>() != p.law())
+    return "law " + j["law"].dump();
+  if (j.contains("mesh_level") && j["mesh_level"].is_number_integer() && j["mesh_level"].get<int>() != p.mesh_level())
+    return "mesh_level " + j["mesh_level"].dump();
+  return "";
+}
+
+void insert_result(Db& db, const std::string& case_id, const nlohmann::json& j, const std::string& line) {
+  Stmt s(db, std::string("INSERT OR REPLACE INTO results(case_id,status,min_D12,max_tau_min,mean_D12,period,regime,"
+                         "volume_drift,steps,dt,t_final,wall_s,code_version,raw_json,recorded_at) "
+                         "VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,") + kNow + ")");
+  s.bind(1, case_id).bind(2, j["status"].get<std::string>()).bind(3, jnum(j, "min_D12"));
+  s.bind(4, jnum(j, "max_tau_min")).bind(5, jnum(j, "mean_D12")).bind(6, jnum(j, "period"));
+  s.bind(7, jstr(j, "regime")).bind(8, jnum(j, "volume_drift")).bind(9, jnum(j, "steps")).bind(10, jnum(j, "dt"));
+  s.bind(11, jnum(j, "t_final")).bind(12, jnum(j, "wall_s")).bind(13, jstr(j, "code_version")).bind(14, line);
+  s.step();
+}
+
+std::string reason_of(const nlohmann::json& j) {
+  for (const char* k : {"reason", "error", "message"})
+    if (j.contains(k) && j[k].is_string()) return j[k].get<std::string>();
+  return "blow-up reported by the solver";
+}
+
+}  // namespace
+
+std::string host_name() {
+  char buf[256] = {0};
+  if (gethostname(buf, sizeof buf - 1) != 0) return "unknown";
+  return buf;
+}
+
+int Store::expected_schema_version() {
+  static const int v = [] {
+    std::regex re(R"(PRAGMA\s+user_version\s*=\s*(\d+))", std::regex::icase);
+    std::string sql = kSchemaSql;
+    int found = 0;
+    for (auto it = std::sregex_iterator(sql.begin(), sql.end(), re); it != std::sregex_iterator(); ++it)
+      found = std::stoi((*it)[1]);
+    return found;
+  }();
+  return v;
+}
+
+std::unique_ptr<Store> Store::open_for_write(const std::string& path) {
+  struct stat st {};
+  if (stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) throw BadInput(path + ": not a regular file");
+  std::unique_ptr<Db> db;
+  try {
+    db = std::make_unique<Db>(path, false, true);
+  } catch (const DbError& e) {
+    throw BadInput(e.what());
+  }
+  bool fresh = false;
+  verify_header(*db, fresh);
+  try {
+    db->exec("PRAGMA journal_mode=WAL");
+    db->exec("PRAGMA synchronous=NORMAL");
+    db->exec("PRAGMA foreign_keys=ON");
+    if (fresh) {
+      Transaction t(*db);
+      db->exec(kSchemaSql);
+      Stmt s(*db, std::string("INSERT OR REPLACE INTO meta(key,value) VALUES('created_at',") + kNow +
+                      "),('created_by',?),('schema_version',?)");
+      s.bind(1, std::string(kGitCommit)).bind(2, std::to_string(expected_schema_version()));
+      s.step();
+      t.commit();
+    }
+  } catch (const DbError& e) {
+    throw BadInput(e.what());
+  }
+  return std::unique_ptr<Store>(new Store(std::move(db)));
+}
+
+std::unique_ptr<Store> Store::open_readonly(const std::string& path) {
+  if (access(path.c_str(), F_OK) != 0) throw BadInput(path + ": no such database file");
+  std::unique_ptr<Db> db;
+  try {
+    db = std::make_unique<Db>(path, true, false);
+  } catch (const DbError& e) {
+    throw BadInput(e.what());
+  }
+  bool fresh = false;
+  verify_header(*db, fresh);
+  if (fresh) throw BadInput(path + ": empty database (no campaign has been run into it)");
+  db->exec("PRAGMA query_only=ON");
+  return std::unique_ptr<Store>(new Store(std::move(db)));
+}
+
+std::int64_t Store::upsert_campaign(const CampaignSpec& spec) {
+  Stmt s(*db_, std::string("INSERT INTO campaigns(name,description,source_path,spec_json,created_at,updated_at) "
+                           "VALUES(?,?,?,?,") + kNow + "," + kNow + ") ON CONFLICT(name) DO UPDATE SET "
+                           "description=excluded.description, source_path=excluded.source_path, "
+                           "spec_json=excluded.spec_json, updated_at=excluded.updated_at");
+  s.bind(1, spec.name).bind(2, spec.description).bind(3, spec.source).bind(4, spec.to_json());
+  s.step();
+  return *find_campaign(spec.name);
+}
+
+std::optional<std::int64_t> Store::find_campaign(const std::string& name) {
+  Stmt s(*db_, "SELECT campaign_id FROM campaigns WHERE name=?");
+  s.bind(1, name);
+  if (!s.step()) return std::nullopt;
+  return s.integer(0);
+}
+
+std::optional<std::string> Store::latest_campaign() {
+  Stmt s(*db_, "SELECT name FROM campaigns ORDER BY updated_at DESC, campaign_id DESC LIMIT 1");
+  if (!s.step()) return std::nullopt;
+  return s.text(0);
+}
+
+int Store::add_cases(std::int64_t campaign_id, const std::vector<CaseParams>& cases, const std::string& origin,
+                     const std::string& runs_dir) {
+  const std::string version = solver_version();
+  Stmt ins(*db_, std::string("INSERT OR IGNORE INTO cases(case_id,params_json,capillary_number,aspect_ratio,law,"
+                             "skalak_C,mesh_level,solver_version,status,est_cost,created_at,out_dir) "
+                             "VALUES(?,?,?,?,?,?,?,?,'queued',?,") + kNow + ",?)");
+  Stmt link(*db_, "INSERT OR IGNORE INTO campaign_cases(campaign_id,case_id,origin) VALUES(?,?,?)");
+  int added = 0;
+  for (const auto& p : cases) {
+    const std::string id = p.identity(version);
+    ins.reset();
+    ins.bind(1, id).bind(2, p.to_json()).bind(3, p.capillary_number()).bind(4, p.aspect_ratio()).bind(5, p.law());
+    ins.bind(6, p.law() == "neo-hookean" ? SqlValue{nullptr} : SqlValue{p.skalak_C()});
+    ins.bind(7, std::int64_t{p.mesh_level()}).bind(8, version).bind(9, p.estimated_cost());
+    ins.bind(10, runs_dir + "/" + id);
+    ins.step();
+    added += db_->changes();
+    link.reset();
+    link.bind(1, campaign_id).bind(2, id).bind(3, origin);
+    link.step();
+  }
+  return added;
+}
+
+namespace {
+const char* kCaseCols =
+    "c.case_id,c.params_json,c.status,c.resumable,c.attempts,c.est_cost,c.out_dir,coalesce(c.host,''),"
+    "coalesce(c.worker_pid,0),coalesce(c.error,'')";
+CaseRow read_case(const Stmt& s) {
+  CaseRow r;
+  r.case_id = s.text(0);
+  r.params = CaseParams::from_json(s.text(1));
+  r.status = s.text(2);
+  r.resumable = s.integer(3) != 0;
+  r.attempts = static_cast<int>(s.integer(4));
+  r.est_cost = s.real(5).value_or(1.0);
+  r.out_dir = s.text(6);
+  r.host = s.text(7);
+  r.worker_pid = s.integer(8);
+  r.error = s.text(9);
+  return r;
+}
+}  // namespace
+
+std::vector<CaseRow> Store::campaign_cases(std::int64_t campaign_id) {
+  Stmt s(*db_, std::string("SELECT ") + kCaseCols +
+                   " FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id WHERE cc.campaign_id=? "
+                   "ORDER BY c.law, c.aspect_ratio, c.skalak_C, c.mesh_level, c.capillary_number");
+  s.bind(1, campaign_id);
+  std::vector<CaseRow> out;
+  while (s.step()) out.push_back(read_case(s));
+  return out;
+}
+
+std::vector<CaseRow> Store::running_cases() {
+  Stmt s(*db_, std::string("SELECT ") + kCaseCols + " FROM cases c WHERE c.status='running'");
+  std::vector<CaseRow> out;
+  while (s.step()) out.push_back(read_case(s));
+  return out;
+}
+
+std::int64_t Store::mark_running(const std::string& case_id, const std::string& host, std::int64_t pid,
+                                 bool resumed) {
+  Transaction t(*db_);
+  Stmt u(*db_, std::string("UPDATE cases SET status='running', attempts=attempts+1, started_at=") + kNow +
+                   ", finished_at=NULL, exit_code=NULL, host=?, worker_pid=? WHERE case_id=?");
+  u.bind(1, host).bind(2, pid).bind(3, case_id);
+  u.step();
+  Stmt a(*db_, std::string("INSERT INTO attempts(case_id,started_at,host,worker_pid,resumed) VALUES(?,") + kNow +
+                   ",?,?,?)");
+  a.bind(1, case_id).bind(2, host).bind(3, pid).bind(4, std::int64_t{resumed ? 1 : 0});
+  a.step();
+  std::int64_t id = sqlite3_last_insert_rowid(db_->handle());
+  t.commit();
+  return id;
+}
+
+std::string Store::record_outcome(const std::string& case_id, std::int64_t attempt_id, const WorkerOutcome& out,
+                                  const std::string& h5_path, const CaseParams& params) {
+  std::string status, outcome, error;
+  bool resumable = false;
+  std::optional<nlohmann::json> j;
+  if (out.signal == 0 && out.exit_code == 0) {
+    j = parse_result_line(out.last_line);
+    if (!j) {
+      status = outcome = "failed";
+      error = "worker exited 0 without a JSON result line (status done|unstable) on stdout; stderr: " + out.stderr_tail;
+    } else if (auto m = mismatch(*j, params); !m.empty()) {
+      status = outcome = "failed";
+      error = "worker reported parameters that differ from the case: " + m;
+      j.reset();
+    } else {
+      status = outcome = (*j)["status"].get<std::string>();
+      if (status == "unstable") error = reason_of(*j);
+    }
+  } else if (out.signal == 0 && out.exit_code == 3) {
+    status = "queued";
+    outcome = "interrupted";
+    resumable = true;
+    error = "interrupted (checkpoint written; resumes with --resume)";
+  } else {
+    status = outcome = "failed";
+    error = out.signal ? "worker killed by signal " + std::to_string(out.signal) + " (" + strsignal(out.signal) + ")"
+                       : "worker exited with code " + std::to_string(out.exit_code) +
+                             (out.exit_code == 2 ? " (bad input)" : "");
+    if (!out.stderr_tail.empty()) error += "; stderr: " + out.stderr_tail;
+  }
+  Transaction t(*db_);
+  if (j) insert_result(*db_, case_id, *j, out.last_line);
+  Stmt u(*db_, std::string("UPDATE cases SET status=?, resumable=?, finished_at=") + kNow +
+                   ", wall_s=?, exit_code=?, code_version=coalesce(?,code_version), error=?, h5_path=? WHERE case_id=?");
+  u.bind(1, status).bind(2, std::int64_t{resumable ? 1 : 0}).bind(3, out.wall_s);
+  u.bind(4, out.signal ? SqlValue{std::int64_t{-out.signal}} : SqlValue{std::int64_t{out.exit_code}});
+  u.bind(5, j ? jstr(*j, "code_version") : SqlValue{nullptr});
+  u.bind(6, error.empty() ? SqlValue{nullptr} : SqlValue{error});
+  u.bind(7, h5_path.empty() ? SqlValue{nullptr} : SqlValue{h5_path}).bind(8, case_id);
+  u.step();
+  Stmt a(*db_, std::string("UPDATE attempts SET finished_at=") + kNow + ", outcome=?, exit_code=?, error=? WHERE attempt_id=?");
+  a.bind(1, outcome).bind(2, out.signal ? SqlValue{std::int64_t{-out.signal}} : SqlValue{std::int64_t{out.exit_code}});
+  a.bind(3, error.empty() ? SqlValue{nullptr} : SqlValue{error}).bind(4, attempt_id);
+  a.step();
+  t.commit();
+  return status;
+}
+
+std::string Store::recover_orphan(const std::string& case_id, const std::string& result_line, bool resumable,
+                                  const std::string& h5_path, const CaseParams& params) {
+  auto j = parse_result_line(result_line);
+  if (j && !mismatch(*j, params).empty()) j.reset();
+  Transaction t(*db_);
+  std::string status;
+  if (j) {
+    status = (*j)["status"].get<std::string>();
+    insert_result(*db_, case_id, *j, result_line);
+    Stmt u(*db_, std::string("UPDATE cases SET status=?, resumable=0, finished_at=") + kNow +
+                     ", exit_code=0, code_version=coalesce(?,code_version), error=?, h5_path=? WHERE case_id=?");
+    u.bind(1, status).bind(2, jstr(*j, "code_version"));
+    u.bind(3, status == "unstable" ? SqlValue{reason_of(*j)} : SqlValue{nullptr});
+    u.bind(4, h5_path.empty() ? SqlValue{nullptr} : SqlValue{h5_path}).bind(5, case_id);
+    u.step();
+  } else {
+    status = "queued";
+    Stmt u(*db_, "UPDATE cases SET status='queued', resumable=?, error=? WHERE case_id=?");
+    u.bind(1, std::int64_t{resumable ? 1 : 0});
+    u.bind(2, std::string("manager stopped while this case ran") + (resumable ? "; resumes from its checkpoint" : ""));
+    u.bind(3, case_id);
+    u.step();
+  }
+  Stmt a(*db_, std::string("UPDATE attempts SET finished_at=") + kNow +
+                   ", outcome=? WHERE case_id=? AND finished_at IS NULL");
+  a.bind(1, std::string(j ? "ingested" : "orphaned")).bind(2, case_id);
+  a.step();
+  t.commit();
+  return status;
+}
+
+int Store::requeue_failed(std::int64_t campaign_id) {
+  Stmt s(*db_, "UPDATE cases SET status='queued', resumable=0 WHERE status='failed' AND case_id IN "
+               "(SELECT case_id FROM campaign_cases WHERE campaign_id=?)");
+  s.bind(1, campaign_id);
+  s.step();
+  return db_->changes();
+}
+
+void Store::save_transitions(std::int64_t campaign_id, const std::vector<Transition>& rows) {
+  Transaction t(*db_);
+  Stmt d(*db_, "DELETE FROM transitions WHERE campaign_id=?");
+  d.bind(1, campaign_id);
+  d.step();
+  Stmt s(*db_, std::string("INSERT INTO transitions(campaign_id,law,aspect_ratio,skalak_C,mesh_level,d12_threshold,"
+                           "n_samples,ca_star_low,ca_star_high,ca_star_below,ca_star_above,ca_min_d12,ca_h,ca_h_low,"
+                           "ca_h_high,ca_h_low_case,ca_h_high_case,method,note,updated_at) "
+                           "VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,") + kNow + ")");
+  auto opt_text = [](const std::string& x) { return x.empty() ? SqlValue{nullptr} : SqlValue{x}; };
+  for (const auto& r : rows) {
+    s.reset();
+    s.bind(1, campaign_id).bind(2, r.law).bind(3, r.aspect_ratio).bind(4, r.skalak_C);
+    s.bind(5, std::int64_t{r.mesh_level}).bind(6, r.d12_threshold).bind(7, std::int64_t{r.n_samples});
+    s.bind_opt(8, r.ca_star_low).bind_opt(9, r.ca_star_high).bind_opt(10, r.ca_star_below).bind_opt(11, r.ca_star_above);
+    s.bind_opt(12, r.ca_min_d12).bind_opt(13, r.ca_h).bind_opt(14, r.ca_h_low).bind_opt(15, r.ca_h_high);
+    s.bind(16, opt_text(r.ca_h_low_case)).bind(17, opt_text(r.ca_h_high_case));
+    s.bind(18, r.method).bind(19, r.note);
+    s.step();
+  }
+  t.commit();
+}
+
+}  // namespace capsim::campaign

@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# A stand-in for `capsim run CASE.toml --out DIR --threads N [--resume] --json` that follows the worker
+# contract (DESIGN.md section 8, issue 4) without the physics, for the campaign manager's fault tests.
+# It "computes" in FAKE_STEPS steps of FAKE_STEP_S seconds, checkpoints to DIR/checkpoint.txt each step,
+# exits 3 after checkpointing on SIGTERM/SIGINT, continues from the checkpoint with --resume, and prints
+# a JSON result whose min_D12 / max_tau_min are simple functions of Ca with known Ca* and CaH:
+#   a/b < 1: min_D12 = 0.02 + 2.0 |Ca - 0.03|   (< 0.05 for |Ca - 0.03| < 0.015)
+#   a/b >= 1: min_D12 = 0.02 + 0.5 |Ca - 0.225| (< 0.05 for |Ca - 0.225| < 0.06)
+#   max_tau_min = CaH - Ca with CaH = 0.70 / 0.35 (neo-hookean, a/b 0.5 / 2) and 2.5 / 1.4 (skalak)
+# Faults, chosen by Ca (comma-separated lists, exact text as written in the case file):
+#   FAKE_CRASH_CA: SIGSEGV itself; FAKE_FAIL_CA: exit 1 with a message; FAKE_UNSTABLE_CA: status unstable;
+#   FAKE_BADINPUT_CA: exit 2. FAKE_LOG: append "done <DIR>" when a case completes.
+set -u
+[ "${1:-}" = "run" ] || { echo "fake_worker: expected 'run'" >&2; exit 2; }
+shift
+case_file="$1"; shift
+out="" resume=0
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --out) out="$2"; shift 2 ;;
+    --threads) shift 2 ;;
+    --resume) resume=1; shift ;;
+    --json) shift ;;
+    *) echo "fake_worker: unknown option $1" >&2; exit 2 ;;
+  esac
+done
+[ -f "$case_file" ] || { echo "fake_worker: $case_file: no such file" >&2; exit 2; }
+mkdir -p "$out"
+get() { awk -F' = ' -v k="$1" '$1 == k { gsub(/"/, "", $2); print $2; exit }' "$case_file"; }
+ca=$(get capillary_number); ar=$(get aspect_ratio); law=$(get law); level=$(get level); C=$(get skalak_C)
+in_list() { local v="$1" list="$2" x; IFS=',' read -ra xs <<< "$list"; for x in "${xs[@]}"; do [ "$x" = "$v" ] && return 0; done; return 1; }
+
+steps=${FAKE_STEPS:-4}
+step_s=${FAKE_STEP_S:-0.05}
+step=0
+if [ $resume = 1 ]; then
+  [ -f "$out/checkpoint.txt" ] || { echo "fake_worker: --resume but no checkpoint in $out" >&2; exit 2; }
+  step=$(cat "$out/checkpoint.txt")
+  echo "fake_worker: resuming at step $step" >&2
+fi
+checkpoint() { echo "$step" > "$out/checkpoint.tmp" && mv "$out/checkpoint.tmp" "$out/checkpoint.txt"; }
+stop=0
+trap 'stop=1' TERM INT
+
+in_list "$ca" "${FAKE_BADINPUT_CA:-}" && { echo "fake_worker: flow.capillary_number: rejected" >&2; exit 2; }
+while [ "$step" -lt "$steps" ]; do
+  if [ $stop = 1 ]; then checkpoint; echo "fake_worker: interrupted at step $step" >&2; exit 3; fi
+  sleep "$step_s"
+  step=$((step + 1))
+  checkpoint
+  echo "fake_worker: step $step/$steps" >&2
+  if [ "$step" = 1 ] && in_list "$ca" "${FAKE_CRASH_CA:-}"; then echo "fake_worker: crashing" >&2; kill -SEGV $$; fi
+  if [ "$step" = 1 ] && in_list "$ca" "${FAKE_FAIL_CA:-}"; then echo "fake_worker: singular matrix" >&2; exit 1; fi
+done
+trap '' TERM INT
+status=done
+in_list "$ca" "${FAKE_UNSTABLE_CA:-}" && status=unstable
+awk -v ca="$ca" -v ar="$ar" -v law="$law" -v level="$level" -v C="$C" -v status="$status" 'BEGIN {
+  if (ar < 1) { d = 0.02 + 2.0 * (ca > 0.03 ? ca - 0.03 : 0.03 - ca); h = (law == "skalak") ? 2.5 : 0.70 }
+  else        { d = 0.02 + 0.5 * (ca > 0.225 ? ca - 0.225 : 0.225 - ca); h = (law == "skalak") ? 1.4 : 0.35 }
+  printf "{\"status\":\"%s\",\"capillary_number\":%s,\"aspect_ratio\":%s,\"law\":\"%s\",\"skalak_C\":%s,", status, ca, ar, law, C
+  printf "\"mesh_level\":%s,\"min_D12\":%.17g,\"max_tau_min\":%.17g,\"mean_D12\":%.17g,\"period\":12.5,", level, d, h - ca, d + 0.1
+  printf "\"regime\":\"%s\",\"volume_drift\":1e-4,\"steps\":100,\"dt\":0.01,\"t_final\":25,\"wall_s\":0.2,", (d < 0.05 ? "swinging" : "tumbling")
+  printf "\"code_version\":\"fake\"%s}\n", (status == "unstable" ? ",\"reason\":\"NaN in velocity at t=3.2\"" : "")
+}'
+[ -n "${FAKE_LOG:-}" ] && echo "done $out" >> "$FAKE_LOG"
+exit 0

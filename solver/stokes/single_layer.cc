@@ -19,19 +19,22 @@ double now_s() {
 // Reference coordinates of the 6 local nodes.
 constexpr double kRefNode[6][2] = {{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}, {0.5, 0.0}, {0.5, 0.5}, {0.0, 0.5}};
 
-// Sub-triangles (apex P, then A, B) of the Duffy map for each local node: one (the element itself, apex at
-// the corner) for a vertex, two for a mid-side node (apex at the mid-side, split through the opposite vertex).
+// Sub-triangles of the Duffy map for each local node, as (A, B) in reference coordinates: the triangle
+// (P, A, B) with P the node at the apex. A vertex has one (the element itself). A mid-side node has the two
+// halves through the opposite vertex, each split again at the midpoint of its far edge: on a near-equilateral
+// element the two halves have a right angle at the apex, and the collapsed-square rule converges much faster
+// on the 45° quarters (measured: 3e-6 → 2e-9 at order 10 on a curved element).
 struct SubTriangle {
-  int a, b;  // reference vertices 0..2 opposite the apex
+  double ax, ay, bx, by;
 };
 const std::vector<SubTriangle>& sub_triangles(int local) {
   static const std::vector<SubTriangle> table[6] = {
-      {{1, 2}},          // vertex 0
-      {{2, 0}},          // vertex 1
-      {{0, 1}},          // vertex 2
-      {{1, 2}, {2, 0}},  // mid-side 3 on edge 0–1
-      {{2, 0}, {0, 1}},  // mid-side 4 on edge 1–2
-      {{0, 1}, {1, 2}},  // mid-side 5 on edge 2–0
+      {{1, 0, 0, 1}},                                                     // vertex 0
+      {{0, 1, 0, 0}},                                                     // vertex 1
+      {{0, 0, 1, 0}},                                                     // vertex 2
+      {{1, 0, 0.5, 0.5}, {0.5, 0.5, 0, 1}, {0, 1, 0, 0.5}, {0, 0.5, 0, 0}},  // mid-side 3 on edge 0–1
+      {{0, 1, 0, 0.5}, {0, 0.5, 0, 0}, {0, 0, 0.5, 0}, {0.5, 0, 1, 0}},      // mid-side 4 on edge 1–2
+      {{0, 0, 0.5, 0}, {0.5, 0, 1, 0}, {1, 0, 0.5, 0.5}, {0.5, 0.5, 0, 1}},  // mid-side 5 on edge 2–0
   };
   return table[local];
 }
@@ -96,8 +99,8 @@ SingleLayer::SingleLayer(const mesh::SurfaceMesh& mesh, const SingleLayerOptions
   for (int l = 0; l < 6; ++l) {
     const double px = kRefNode[l][0], py = kRefNode[l][1];
     for (const auto& st : sub_triangles(l)) {
-      const double ax = kRefNode[st.a][0] - px, ay = kRefNode[st.a][1] - py;
-      const double bx = kRefNode[st.b][0] - px, by = kRefNode[st.b][1] - py;
+      const double ax = st.ax - px, ay = st.ay - py;
+      const double bx = st.bx - px, by = st.by - py;
       const double det = std::abs(ax * by - ay * bx);
       for (int i = 0; i < opt_.duffy_order; ++i) {
         const double s = gl.nodes[i];
@@ -108,6 +111,18 @@ SingleLayer::SingleLayer(const mesh::SurfaceMesh& mesh, const SingleLayerOptions
         }
       }
     }
+  }
+
+  for (int l = 0; l < 6; ++l) {
+    ShapeTable& t = duffy_soa_[l];
+    t.count = static_cast<int>(duffy_[l].size());
+    for (int a = 0; a < 6; ++a)
+      for (const ShapeAt& sa : duffy_[l]) {
+        t.n[a].push_back(sa.n[a]);
+        t.dxi[a].push_back(sa.dxi[a]);
+        t.deta[a].push_back(sa.deta[a]);
+      }
+    for (const ShapeAt& sa : duffy_[l]) t.w.push_back(sa.w);
   }
 
   if (opt_.near_subdivision > 0) {
@@ -226,7 +241,7 @@ inline void add_block(const double x0[3], const double* px, const double* py, co
   for (int p = begin; p < end; ++p) {
     const double dx = x0[0] - px[p], dy = x0[1] - py[p], dz = x0[2] - pz[p];
     const double r2 = dx * dx + dy * dy + dz * dz;
-    const double inv = r2 == 0.0 ? 0.0 : 1.0 / std::sqrt(r2);
+    const double inv = r2 == 0.0 ? 0.0 : kernel::rsqrt_arith(r2);
     const double sc = (dx * qx[p] + dy * qy[p] + dz * qz[p]) * inv * inv * inv;
     ax += qx[p] * inv + dx * sc;
     ay += qy[p] * inv + dy * sc;
@@ -261,20 +276,44 @@ void SingleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Ma
           R[a][c] = x(c, el[a]) - x0[c];
           Q[a][c] = q(c, el[a]);
         }
-      for (const ShapeAt& s : duffy_[l]) {
-        double d[3] = {0, 0, 0}, t1[3] = {0, 0, 0}, t2[3] = {0, 0, 0}, qq[3] = {0, 0, 0};
-        for (int a = 0; a < 6; ++a)
-          for (int c = 0; c < 3; ++c) {
-            d[c] += s.n[a] * R[a][c];
-            t1[c] += s.dxi[a] * R[a][c];
-            t2[c] += s.deta[a] * R[a][c];
-            qq[c] += s.n[a] * Q[a][c];
-          }
+      const ShapeTable& tb = duffy_soa_[l];
+      const double *n0 = tb.n[0].data(), *n1 = tb.n[1].data(), *n2 = tb.n[2].data(), *n3 = tb.n[3].data(),
+                   *n4 = tb.n[4].data(), *n5 = tb.n[5].data();
+      const double *a0 = tb.dxi[0].data(), *a1 = tb.dxi[1].data(), *a2 = tb.dxi[2].data(), *a3 = tb.dxi[3].data(),
+                   *a4 = tb.dxi[4].data(), *a5 = tb.dxi[5].data();
+      const double *b0 = tb.deta[0].data(), *b1 = tb.deta[1].data(), *b2 = tb.deta[2].data(),
+                   *b3 = tb.deta[3].data(), *b4 = tb.deta[4].data(), *b5 = tb.deta[5].data();
+      const double* wt = tb.w.data();
+      double sx = 0.0, sy = 0.0, sz = 0.0;
+#pragma omp simd reduction(+ : sx, sy, sz)
+      for (int p = 0; p < tb.count; ++p) {
+        double d[3], t1[3], t2[3], qq[3];
+        for (int c = 0; c < 3; ++c) {
+          d[c] = n0[p] * R[0][c] + n1[p] * R[1][c] + n2[p] * R[2][c] + n3[p] * R[3][c] + n4[p] * R[4][c] +
+                 n5[p] * R[5][c];
+          t1[c] = a0[p] * R[0][c] + a1[p] * R[1][c] + a2[p] * R[2][c] + a3[p] * R[3][c] + a4[p] * R[4][c] +
+                  a5[p] * R[5][c];
+          t2[c] = b0[p] * R[0][c] + b1[p] * R[1][c] + b2[p] * R[2][c] + b3[p] * R[3][c] + b4[p] * R[4][c] +
+                  b5[p] * R[5][c];
+          qq[c] = n0[p] * Q[0][c] + n1[p] * Q[1][c] + n2[p] * Q[2][c] + n3[p] * Q[3][c] + n4[p] * Q[4][c] +
+                  n5[p] * Q[5][c];
+        }
         const double nx = t1[1] * t2[2] - t1[2] * t2[1], ny = t1[2] * t2[0] - t1[0] * t2[2],
                      nz = t1[0] * t2[1] - t1[1] * t2[0];
-        const double wj = s.w * std::sqrt(nx * nx + ny * ny + nz * nz);
-        kernel::add_stokeslet(-d[0], -d[1], -d[2], wj * qq[0], wj * qq[1], wj * qq[2], acc);
+        const double nn = nx * nx + ny * ny + nz * nz;
+        const double wj = wt[p] * nn * kernel::rsqrt_arith(nn);  // w |t1 × t2|
+        // r = x0 − x = −d; Duffy points are interior, so r ≠ 0 on a non-degenerate element.
+        const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        const double inv = kernel::rsqrt_arith(r2);
+        const double rq = -(d[0] * qq[0] + d[1] * qq[1] + d[2] * qq[2]);
+        const double sc = rq * inv * inv;
+        sx += wj * inv * (qq[0] - d[0] * sc);
+        sy += wj * inv * (qq[1] - d[1] * sc);
+        sz += wj * inv * (qq[2] - d[2] * sc);
       }
+      acc[0] += sx;
+      acc[1] += sy;
+      acc[2] += sz;
     }
     // Near-singular neighbours: regular rule out, subdivided rule in.
     if (nr > 0) {

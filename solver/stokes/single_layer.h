@@ -59,7 +59,7 @@ enum class KernelChoice { Fast, Plain };
 /// @brief Options of the single-layer operator.
 struct SingleLayerOptions {
   int regular_degree = 4;      ///< triangle rule for regular elements: 4 (6 pts), 5 (7 pts), 6 (12 pts)
-  int duffy_order = 10;        ///< Gauss-Legendre points per direction of the Duffy square (≥ 1)
+  int duffy_order = 6;         ///< Gauss-Legendre points per direction of each Duffy square (≥ 1)
   /// Near-singular correction: elements that share a vertex with an element containing the target (but do
   /// not contain it) are re-integrated with `near_degree` on each of 4^near_subdivision sub-triangles
   /// (0 = off). Without it the error at mid-side nodes (h/2 from such elements) is O(h).
@@ -128,6 +128,13 @@ class SingleLayer {
   std::vector<int> mirror_;                 // empty if the mesh has none
   std::vector<ShapeAt> regular_;            // rule points
   std::vector<ShapeAt> duffy_[6];           // per local node position
+  /// The same Duffy points as structure of arrays (vectorised loop): n[a], dxi[a], deta[a] for a = 0..5,
+  /// then w, each of length duffy_count_[l].
+  struct ShapeTable {
+    int count = 0;
+    AlignedVector n[6], dxi[6], deta[6], w;
+  };
+  ShapeTable duffy_soa_[6];
   std::vector<ShapeAt> near_rule_;          // subdivided rule (empty if off)
   std::vector<int> near_offsets_, near_elements_;  // node → near-singular elements CSR
   // Work arrays (SoA sources, targets, results).

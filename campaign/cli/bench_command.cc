@@ -126,6 +126,7 @@ int bench_command(const std::vector<std::string>& args) {
   for (int b = 1; b <= 4; ++b) {
     variants.push_back({"fast rsqrt+Newton B=" + std::to_string(b), {b, sk::InvSqrt::Newton}});
     variants.push_back({"fast sqrt+div    B=" + std::to_string(b), {b, sk::InvSqrt::SqrtDiv}});
+    if (b >= 2) variants.push_back({"fast hybrid      B=" + std::to_string(b), {b, sk::InvSqrt::Hybrid}});
   }
   const sk::FastConfig def{};
   double fast_rate = 0.0, fast_err = 0.0;

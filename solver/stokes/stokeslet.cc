@@ -23,7 +23,9 @@ constexpr double kC1 = 0.5, kC2 = 0.375, kC3 = 0.3125, kC4 = 35.0 / 128.0;
 constexpr int kLanes = 8;
 constexpr const char* kIsa = "avx512";
 
-template <int B, bool kNewton>
+// kMode: 0 = sqrt+div, 1 = rsqrt14+Newton, 2 = hybrid (odd target vectors use sqrt+div, even ones Newton:
+// the divider and the FMA pipes then work in parallel).
+template <int B, int kMode>
 inline void tile(const double* tx, const double* ty, const double* tz, const Sources& s, double* ux, double* uy,
                  double* uz) {
   __m512d X[B], Y[B], Z[B], UX[B], UY[B], UZ[B];
@@ -50,7 +52,7 @@ inline void tile(const double* tx, const double* ty, const double* tz, const Sou
       // Lanes with r2 == 0 get 1/r = 0; unordered (NaN) lanes stay in so that NaN propagates.
       const __mmask8 k = _mm512_cmp_pd_mask(r2, zero, _CMP_NEQ_UQ);
       __m512d y;
-      if constexpr (kNewton) {
+      if (kMode == 1 || (kMode == 2 && b % 2 == 0)) {
         y = _mm512_maskz_rsqrt14_pd(k, r2);
         const __m512d e = _mm512_fnmadd_pd(_mm512_mul_pd(r2, y), y, one);
         const __m512d p = _mm512_fmadd_pd(_mm512_fmadd_pd(e, c3, c2), e, c1);
@@ -77,7 +79,7 @@ inline void tile(const double* tx, const double* ty, const double* tz, const Sou
 constexpr int kLanes = 4;
 constexpr const char* kIsa = "avx2";
 
-template <int B, bool kNewton>
+template <int B, int kMode>
 inline void tile(const double* tx, const double* ty, const double* tz, const Sources& s, double* ux, double* uy,
                  double* uz) {
   __m256d X[B], Y[B], Z[B], UX[B], UY[B], UZ[B];
@@ -105,7 +107,7 @@ inline void tile(const double* tx, const double* ty, const double* tz, const Sou
       const __m256d r2 = _mm256_fmadd_pd(dz, dz, _mm256_fmadd_pd(dy, dy, _mm256_mul_pd(dx, dx)));
       const __m256d keep = _mm256_cmp_pd(r2, zero, _CMP_NEQ_UQ);
       __m256d y;
-      if constexpr (kNewton) {
+      if (kMode == 1 || (kMode == 2 && b % 2 == 0)) {
         // Single-precision estimate (r2 within float range for capsule geometries), then one step.
         y = _mm256_cvtps_pd(_mm_rsqrt_ps(_mm256_cvtpd_ps(r2)));
         y = _mm256_and_pd(y, keep);
@@ -134,8 +136,8 @@ inline void tile(const double* tx, const double* ty, const double* tz, const Sou
 constexpr int kLanes = 8;
 constexpr const char* kIsa = "portable";
 
-// Portable: the same tile structure, lanes as a short inner loop the compiler vectorises.
-template <int B, bool kNewton>
+// Portable: the same tile structure, lanes as a short inner loop the compiler vectorises (kMode unused).
+template <int B, int kMode>
 inline void tile(const double* tx, const double* ty, const double* tz, const Sources& s, double* ux, double* uy,
                  double* uz) {
   constexpr int W = kLanes * B;
@@ -161,7 +163,7 @@ inline void tile(const double* tx, const double* ty, const double* tz, const Sou
 }
 #endif
 
-template <int B, bool kNewton>
+template <int B, int kMode>
 void run_tiles(const Targets& t, const Sources& s, const Result& u) {
   constexpr int W = kLanes * B;
   const int ntiles = (t.n + W - 1) / W;
@@ -169,7 +171,7 @@ void run_tiles(const Targets& t, const Sources& s, const Result& u) {
   for (int it = 0; it < ntiles; ++it) {
     const int i0 = it * W;
     if (i0 + W <= t.n) {
-      tile<B, kNewton>(t.x + i0, t.y + i0, t.z + i0, s, u.x + i0, u.y + i0, u.z + i0);
+      tile<B, kMode>(t.x + i0, t.y + i0, t.z + i0, s, u.x + i0, u.y + i0, u.z + i0);
     } else {
       // Partial last tile: pad with copies of the last target, keep only the valid lanes.
       alignas(64) double bx[W], by[W], bz[W], ox[W], oy[W], oz[W];
@@ -179,7 +181,7 @@ void run_tiles(const Targets& t, const Sources& s, const Result& u) {
         by[l] = t.y[i];
         bz[l] = t.z[i];
       }
-      tile<B, kNewton>(bx, by, bz, s, ox, oy, oz);
+      tile<B, kMode>(bx, by, bz, s, ox, oy, oz);
       for (int l = 0; i0 + l < t.n; ++l) {
         u.x[i0 + l] = ox[l];
         u.y[i0 + l] = oy[l];
@@ -189,13 +191,13 @@ void run_tiles(const Targets& t, const Sources& s, const Result& u) {
   }
 }
 
-template <bool kNewton>
+template <int kMode>
 void dispatch_block(const Targets& t, const Sources& s, const Result& u, int block) {
   switch (block) {
-    case 1: run_tiles<1, kNewton>(t, s, u); break;
-    case 2: run_tiles<2, kNewton>(t, s, u); break;
-    case 3: run_tiles<3, kNewton>(t, s, u); break;
-    case 4: run_tiles<4, kNewton>(t, s, u); break;
+    case 1: run_tiles<1, kMode>(t, s, u); break;
+    case 2: run_tiles<2, kMode>(t, s, u); break;
+    case 3: run_tiles<3, kMode>(t, s, u); break;
+    case 4: run_tiles<4, kMode>(t, s, u); break;
     default: throw std::invalid_argument("stokes kernel: block must be 1..4, got " + std::to_string(block));
   }
 }
@@ -204,10 +206,11 @@ void dispatch_block(const Targets& t, const Sources& s, const Result& u, int blo
 
 void sum_fast(const Targets& t, const Sources& s, const Result& u, const FastConfig& config) {
   if (t.n <= 0) return;
-  if (config.inv_sqrt == InvSqrt::Newton)
-    dispatch_block<true>(t, s, u, config.block);
-  else
-    dispatch_block<false>(t, s, u, config.block);
+  switch (config.inv_sqrt) {
+    case InvSqrt::SqrtDiv: dispatch_block<0>(t, s, u, config.block); break;
+    case InvSqrt::Newton: dispatch_block<1>(t, s, u, config.block); break;
+    case InvSqrt::Hybrid: dispatch_block<2>(t, s, u, config.block); break;
+  }
 }
 
 void sum_plain(const Targets& t, const Sources& s, const Result& u) {

@@ -10,7 +10,9 @@
 /// Two implementations of the same sum:
 ///  - sum_fast: targets in SIMD lanes, one source broadcast at a time, several target vectors per tile
 ///    (register blocking), OpenMP static schedule over target tiles; 1/r from the hardware reciprocal
-///    square-root estimate refined by one high-order Newton (Householder) step to full double accuracy.
+///    square-root estimate refined by one high-order Newton (Householder) step to full double accuracy,
+///    alternating with the vector sqrt + division on every other target vector (InvSqrt::Hybrid: the divider
+///    runs next to the FMA pipes).
 ///    The instruction set is chosen at compile time: AVX-512F, else AVX2+FMA, else a portable loop that
 ///    the compiler vectorises (see kernel_isa()).
 ///  - sum_plain: the reference, a straightforward `#pragma omp simd` loop over sources with 1/sqrt(r²)
@@ -82,12 +84,16 @@ struct Result {
 enum class InvSqrt {
   Newton,   ///< hardware estimate (rsqrt14 / rsqrtps) + one high-order Newton step (default)
   SqrtDiv,  ///< 1/sqrt(r²) with the vector sqrt and division instructions
+  Hybrid,   ///< alternate target vectors between the two (divider and FMA pipes busy at once; block ≥ 2)
 };
 
 /// @brief Tuning of the fast kernel (defaults = the measured best on the development machine).
+/// Measured on the development machine (AMD Zen 5, AVX-512, perf cycles:u, one thread, level-3 problem):
+/// cycles per interaction 1.71 (Newton, any block), 1.71 (sqrt+div), 1.53 (hybrid, block 2); the plain
+/// loop 1.88 when vectorised (-fno-math-errno), about 15 when not.
 struct FastConfig {
-  int block = 3;                        ///< target vectors per tile (1..4): register blocking
-  InvSqrt inv_sqrt = InvSqrt::Newton;   ///< see InvSqrt
+  int block = 2;                        ///< target vectors per tile (1..4): register blocking
+  InvSqrt inv_sqrt = InvSqrt::Hybrid;   ///< see InvSqrt
 };
 
 /// @brief The fast kernel (see the file comment). u is overwritten.

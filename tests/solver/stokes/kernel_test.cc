@@ -89,12 +89,12 @@ TEST(StokesletKernel, FastMatchesPlainAndLongDoubleForAllVariants) {
   EXPECT_LT(plain_err, 1e-13);
   std::printf("  ISA %s, width %d; plain vs long double %.2e\n", kernel_isa(), simd_width(), plain_err);
   for (int block = 1; block <= 4; ++block)
-    for (const InvSqrt inv : {InvSqrt::Newton, InvSqrt::SqrtDiv}) {
+    for (const InvSqrt inv : {InvSqrt::Newton, InvSqrt::SqrtDiv, InvSqrt::Hybrid}) {
       std::vector<double> fx(203, -1.0), fy(203, -1.0), fz(203, -1.0);
       sum_fast(c.targets(), c.sources(), {fx.data(), fy.data(), fz.data()}, {block, inv});
       const double e_plain = max_rel(fx, fy, fz, px, py, pz), e_ref = max_rel(fx, fy, fz, rx, ry, rz);
       std::printf("  block %d %s: vs plain %.2e, vs long double %.2e\n", block,
-                  inv == InvSqrt::Newton ? "rsqrt+Newton" : "sqrt+div", e_plain, e_ref);
+                  inv == InvSqrt::Newton ? "rsqrt+Newton" : inv == InvSqrt::SqrtDiv ? "sqrt+div" : "hybrid", e_plain, e_ref);
       EXPECT_LT(e_plain, 1e-12) << "block " << block;
       EXPECT_LT(e_ref, 1e-13) << "block " << block;
     }

@@ -152,6 +152,12 @@ SingleLayer::SingleLayer(const mesh::SurfaceMesh& mesh, const SingleLayerOptions
             shape_at(t[0][0] + u * ax + v * bx, t[0][1] + u * ay + v * by, 0.5 * near_rule.weights[k] * det));
       }
     }
+    // The regular rule with negative weights: one contiguous block per element both removes the regular
+    // contribution and adds the subdivided one.
+    for (const ShapeAt& r : regular_) {
+      near_rule_.push_back(r);
+      near_rule_.back().w = -r.w;
+    }
     // Near-singular neighbours: elements sharing a vertex with an element that contains the node.
     near_offsets_.assign(1, 0);
     std::vector<int> own, cand;
@@ -315,12 +321,10 @@ void SingleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Ma
       acc[1] += sy;
       acc[2] += sz;
     }
-    // Near-singular neighbours: regular rule out, subdivided rule in.
+    // Near-singular neighbours: subdivided rule in, regular rule out (negative weights), one block each.
     if (nr > 0) {
       for (int k = near_offsets_[i]; k < near_offsets_[i + 1]; ++k) {
         const int e = near_elements_[k];
-        add_block(x0, sx_.data(), sy_.data(), sz_.data(), sqx_.data(), sqy_.data(), sqz_.data(), e * nq,
-                  (e + 1) * nq, -1.0, acc);
         add_block(x0, nx_.data(), ny_.data(), nz_.data(), nqx_.data(), nqy_.data(), nqz_.data(), e * nr,
                   (e + 1) * nr, 1.0, acc);
       }

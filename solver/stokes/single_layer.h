@@ -135,7 +135,7 @@ class SingleLayer {
     AlignedVector n[6], dxi[6], deta[6], w;
   };
   ShapeTable duffy_soa_[6];
-  std::vector<ShapeAt> near_rule_;          // subdivided rule (empty if off)
+  std::vector<ShapeAt> near_rule_;          // subdivided rule, then the regular rule negated (empty if off)
   std::vector<int> near_offsets_, near_elements_;  // node → near-singular elements CSR
   // Work arrays (SoA sources, targets, results).
   AlignedVector sx_, sy_, sz_, sqx_, sqy_, sqz_;

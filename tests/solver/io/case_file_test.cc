@@ -1,0 +1,182 @@
+// Case file: time series, attributes and snapshots written and read back; XDMF references; resume.
+#include "solver/io/case_file.h"
+
+#include <cmath>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
+#include "capsim/version.h"
+#include "solver/io/io_error.h"
+
+namespace capsim::io {
+namespace {
+
+std::filesystem::path scratch(const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::path(CAPSIM_TEST_TMP) / "io_case";
+  std::filesystem::create_directories(dir);
+  return dir / name;
+}
+
+diagnostics::StepRecord record(int i) {
+  const double t = 0.01 * i;
+  return {t, 0.3 + 0.1 * std::sin(t), 1.2 + 0.01 * i, 0.8 - 1e-3 * i, std::remainder(-0.5 * t, M_PI),
+          -0.01 * std::cos(3 * t), 4.18879 + 1e-9 * i, 13.2 + 1e-8 * i, {std::cos(t), std::sin(t), 0.0}};
+}
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+const Attribute* find(const std::vector<Attribute>& attrs, const std::string& key) {
+  for (const auto& a : attrs)
+    if (a.key == key) return &a;
+  return nullptr;
+}
+
+TEST(CaseFile, RoundTripOfSeriesAttributesAndSnapshots) {
+  const auto file = scratch("case.h5");
+  const auto mesh = mesh::make_capsule_mesh(1, 2.0);
+  const std::vector<Attribute> params{{"capillary_number", 0.3}, {"mesh_level", 1}, {"law", "skalak"}};
+  diagnostics::TimeSeries expected;
+  Eigen::Matrix3Xd x1 = mesh.nodes * 1.01;
+  Eigen::VectorXd qn = Eigen::VectorXd::LinSpaced(mesh.num_nodes(), -1.0, 2.0);
+  {
+    CaseWriter w(file, params, {.buffer_rows = 64});
+    for (int i = 0; i < 1000; ++i) {
+      w.append(record(i));
+      expected.push_back(record(i));
+    }
+    w.write_snapshot(0.0, 0, mesh, mesh.nodes);
+    const std::vector<NodeField> fields{NodeField::scalar("q_n", qn), NodeField::vector("q", 2.0 * mesh.nodes)};
+    w.write_snapshot(9.99, 999, mesh, x1, fields);
+    w.set_attribute({"min_D12", 0.21});
+    w.set_attribute({"regime", "tumbling"});
+    EXPECT_EQ(w.rows(), 1000u);
+    w.close();
+  }
+  const auto c = read_case_file(file);
+  EXPECT_TRUE(c.series == expected);  // exact: binary64 stored and read back
+  EXPECT_EQ(c.num_snapshots, 2);
+  ASSERT_NE(find(c.attributes, "code_version"), nullptr);
+  EXPECT_EQ(std::get<std::string>(find(c.attributes, "code_version")->value), kGitCommit);
+  EXPECT_EQ(std::get<double>(find(c.attributes, "capillary_number")->value), 0.3);
+  EXPECT_EQ(std::get<std::int64_t>(find(c.attributes, "mesh_level")->value), 1);
+  EXPECT_EQ(std::get<std::string>(find(c.attributes, "law")->value), "skalak");
+  EXPECT_EQ(std::get<std::string>(find(c.attributes, "regime")->value), "tumbling");
+  EXPECT_EQ(std::get<double>(find(c.attributes, "min_D12")->value), 0.21);
+
+  const auto s = read_snapshot(file, 1);
+  EXPECT_EQ(s.t, 9.99);
+  EXPECT_EQ(s.step, 999);
+  EXPECT_EQ(s.positions, x1);
+  EXPECT_EQ(s.elements, mesh.elements);
+  ASSERT_EQ(s.fields.size(), 2u);
+  for (const auto& f : s.fields) {
+    if (f.name == "q_n") EXPECT_EQ(Eigen::VectorXd(f.values.transpose()), qn);
+    else EXPECT_EQ(f.values, Eigen::MatrixXd(2.0 * mesh.nodes));
+  }
+  EXPECT_THROW(read_snapshot(file, 2), IoError);
+}
+
+TEST(CaseFile, XdmfReferencesExistingDatasetsOfTheRightShape) {
+  const auto file = scratch("xdmf.h5");
+  const auto mesh = mesh::make_sphere_mesh(1);
+  for (auto topo : {XdmfTopology::Triangle6, XdmfTopology::LinearSplit}) {
+    CaseWriter w(file, {}, {.topology = topo});
+    const Eigen::VectorXd tau = Eigen::VectorXd::Ones(mesh.num_nodes());
+    const std::vector<NodeField> fields{NodeField::scalar("tau1", tau)};
+    w.write_snapshot(0.0, 0, mesh, mesh.nodes, fields);
+    w.write_snapshot(0.5, 10, mesh, mesh.nodes, fields);
+    w.close();
+    const std::string xmf = slurp(w.xdmf_file());
+    EXPECT_NE(xmf.find(topo == XdmfTopology::Triangle6 ? "TopologyType=\"Triangle_6\"" : "TopologyType=\"Triangle\""),
+              std::string::npos);
+    EXPECT_NE(xmf.find("<Time Value=\"0.5\"/>"), std::string::npos);
+    // Every DataItem "Dims" → "file.h5:/path": the dataset exists with exactly these dimensions.
+    const std::regex item(R"re(<DataItem Dimensions="([0-9 ]+)"[^>]*>([^:<]+):([^<]+)</DataItem>)re");
+    hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    ASSERT_GE(f, 0);
+    int items = 0;
+    for (std::sregex_iterator it(xmf.begin(), xmf.end(), item), end; it != end; ++it, ++items) {
+      EXPECT_EQ((*it)[2].str(), "xdmf.h5");
+      const std::string path = (*it)[3].str();
+      hid_t d = H5Dopen2(f, path.c_str(), H5P_DEFAULT);
+      ASSERT_GE(d, 0) << path;
+      hid_t sp = H5Dget_space(d);
+      hsize_t dims[2] = {0, 0};
+      const int rank = H5Sget_simple_extent_dims(sp, dims, nullptr);
+      std::string shape = std::to_string(dims[0]) + (rank == 2 ? " " + std::to_string(dims[1]) : "");
+      EXPECT_EQ(shape, (*it)[1].str()) << path;
+      H5Sclose(sp);
+      H5Dclose(d);
+    }
+    H5Fclose(f);
+    EXPECT_EQ(items, 2 * 3);  // topology, geometry, tau1 per snapshot
+    // Linear split: 4 flat triangles per P2 element, all node indices valid.
+    const auto s = read_snapshot(file, 0);
+    EXPECT_EQ(s.elements.size(), mesh.elements.size());
+  }
+}
+
+TEST(CaseFile, ResumeKeepsTheCheckpointedSeriesAndDropsLaterSnapshots) {
+  const auto file = scratch("resume.h5");
+  const auto mesh = mesh::make_sphere_mesh(1);
+  {
+    CaseWriter w(file, {{"capillary_number", 0.9}});
+    for (int i = 0; i < 1000; ++i) {
+      w.append(record(i));
+      if (i % 400 == 0) w.write_snapshot(record(i).t, i, mesh, mesh.nodes);  // t = 0, 4, 8
+    }
+  }  // destructor closes
+  diagnostics::TimeSeries at_checkpoint;
+  for (int i = 0; i < 500; ++i) at_checkpoint.push_back(record(i));  // up to t = 4.99
+  {
+    CaseWriter w = CaseWriter::resume(file, {}, at_checkpoint);
+    EXPECT_EQ(w.rows(), 500u);
+    for (int i = 500; i < 700; ++i) w.append(record(i));
+    w.write_snapshot(record(699).t, 699, mesh, mesh.nodes);
+    w.close();
+  }
+  const auto c = read_case_file(file);
+  diagnostics::TimeSeries expected;
+  for (int i = 0; i < 700; ++i) expected.push_back(record(i));
+  EXPECT_TRUE(c.series == expected);
+  EXPECT_EQ(c.num_snapshots, 3);  // t = 0, 4 kept; 8 dropped; 6.99 new
+  EXPECT_EQ(read_snapshot(file, 2).step, 699);
+  EXPECT_EQ(std::get<double>(find(c.attributes, "capillary_number")->value), 0.9);
+  const std::string xmf = slurp(std::filesystem::path(file).replace_extension(".xmf"));
+  EXPECT_EQ(xmf.find("<Time Value=\"8\"/>"), std::string::npos);
+  EXPECT_NE(xmf.find("<Time Value=\"6.9900000000000002\"/>"), std::string::npos);
+}
+
+TEST(CaseFile, ErrorsNameTheFile) {
+  const auto bad = scratch("no_such_dir") / "case.h5";
+  try {
+    CaseWriter w(bad, {});
+    FAIL() << "expected IoError";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find(bad.string()), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(CaseWriter(scratch("reserved.h5"), std::vector<Attribute>{{"code_version", "x"}}),
+               std::invalid_argument);
+  EXPECT_THROW(read_case_file(scratch("missing.h5")), IoError);
+  // A text file is not a case file.
+  std::ofstream(scratch("text.h5")) << "hello";
+  EXPECT_THROW(read_case_file(scratch("text.h5")), IoError);
+  const auto mesh = mesh::make_sphere_mesh(1);
+  CaseWriter w(scratch("fields.h5"), {});
+  const std::vector<NodeField> bad_name{NodeField::scalar("a/b", Eigen::VectorXd::Zero(mesh.num_nodes()))};
+  EXPECT_THROW(w.write_snapshot(0, 0, mesh, mesh.nodes, bad_name), std::invalid_argument);
+  const std::vector<NodeField> bad_size{NodeField::scalar("q_n", Eigen::VectorXd::Zero(3))};
+  EXPECT_THROW(w.write_snapshot(0, 0, mesh, mesh.nodes, bad_size), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace capsim::io

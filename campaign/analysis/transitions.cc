@@ -86,8 +86,9 @@ Transition analyse_group(Transition t, std::vector<Sample> samples, double thr) 
 
 namespace {
 double quantise(double x, double tolerance) {
-  const double q = std::pow(10.0, std::floor(std::log10(tolerance / 2)));
-  return Decimal::from_double(std::round(x / q) * q).to_double();
+  // Round to a decimal quantum 10^-scale below tolerance/2, exactly (0.0275, not 0.027500000000000004).
+  const int scale = std::max(0, static_cast<int>(-std::floor(std::log10(tolerance / 2))));
+  return Decimal{static_cast<std::int64_t>(std::llround(x * std::pow(10.0, scale))), scale}.to_double();
 }
 }  // namespace
 

@@ -114,7 +114,7 @@ int campaign_command(const std::vector<std::string>& args) {
     }
     return status(status_db, status_name);
   } catch (const BadInput& e) {
-    std::fprintf(stderr, "capsim campaign: error: %s\n", e.what());
+    std::fprintf(stderr, "capsim campaign: error: %s\n", campaign::one_line(e.what()).c_str());
     return kExitBadInput;
   }
 }

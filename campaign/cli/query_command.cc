@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -147,23 +148,30 @@ int cases(campaign::Store& store, const std::string& name, campaign::Format fmt,
 
 int sql(campaign::Store& store, const std::string& text, campaign::Format fmt) {
   sqlite3* h = store.db().handle();
+  // Prepare every statement first: if any of them writes, nothing runs.
+  struct Finalize {
+    void operator()(sqlite3_stmt* s) const { sqlite3_finalize(s); }
+  };
+  std::vector<std::unique_ptr<sqlite3_stmt, Finalize>> stmts;
   const char* p = text.c_str();
-  bool any = false;
   while (*p) {
     sqlite3_stmt* raw = nullptr;
     const char* tail = nullptr;
-    int rc = sqlite3_prepare_v2(h, p, -1, &raw, &tail);
-    if (rc != SQLITE_OK) throw BadInput(std::string("sql: ") + sqlite3_errmsg(h));
+    if (sqlite3_prepare_v2(h, p, -1, &raw, &tail) != SQLITE_OK) throw BadInput(std::string("sql: ") + sqlite3_errmsg(h));
     p = tail;
     if (!raw) continue;  // whitespace or comment
-    if (!sqlite3_stmt_readonly(raw)) {
-      std::string stmt = sqlite3_sql(raw);
-      sqlite3_finalize(raw);
-      throw BadInput("sql: refused, the database is opened read-only and this statement writes: " + stmt);
-    }
+    stmts.emplace_back(raw);
+    if (!sqlite3_stmt_readonly(raw))
+      throw BadInput(std::string("sql: refused, the database is opened read-only and this statement writes: ") +
+                     sqlite3_sql(raw));
+  }
+  if (stmts.empty()) throw BadInput("sql: empty statement");
+  for (auto& st : stmts) {
+    sqlite3_stmt* raw = st.get();
     campaign::Table t;
     const int n = sqlite3_column_count(raw);
     for (int c = 0; c < n; ++c) t.columns.push_back(sqlite3_column_name(raw, c));
+    int rc;
     while ((rc = sqlite3_step(raw)) == SQLITE_ROW) {
       std::vector<SqlValue> row;
       for (int c = 0; c < n; ++c) {
@@ -179,18 +187,9 @@ int sql(campaign::Store& store, const std::string& text, campaign::Format fmt) {
       }
       t.rows.push_back(std::move(row));
     }
-    if (rc != SQLITE_DONE) {
-      std::string msg = sqlite3_errmsg(h);
-      sqlite3_finalize(raw);
-      throw BadInput("sql: " + msg);
-    }
-    sqlite3_finalize(raw);
-    if (n > 0) {
-      std::printf("%s", campaign::render(t, fmt).c_str());
-      any = true;
-    }
+    if (rc != SQLITE_DONE) throw BadInput(std::string("sql: ") + sqlite3_errmsg(h));
+    if (n > 0) std::printf("%s", campaign::render(t, fmt).c_str());
   }
-  if (!any && text.find_first_not_of(" \t\r\n;") == std::string::npos) throw BadInput("sql: empty statement");
   return 0;
 }
 
@@ -241,10 +240,10 @@ int query_command(const std::vector<std::string>& args) {
     if (*cs) return cases(*store, camp, fmt, law, ar, ca_min, ca_max, status);
     return sql(*store, text, fmt);
   } catch (const BadInput& e) {
-    std::fprintf(stderr, "capsim query: error: %s\n", e.what());
+    std::fprintf(stderr, "capsim query: error: %s\n", campaign::one_line(e.what()).c_str());
     return kExitBadInput;
   } catch (const campaign::DbError& e) {
-    std::fprintf(stderr, "capsim query: error: %s\n", e.what());
+    std::fprintf(stderr, "capsim query: error: %s\n", campaign::one_line(e.what()).c_str());
     return kExitBadInput;
   }
 }

@@ -90,6 +90,8 @@ std::string CaseParams::to_json() const {
 std::string CaseParams::to_toml() const {
   std::map<std::string, std::string> sections;
   for (const auto& [k, v] : values_) {
+    // dt = "auto" is the solver's default (an unset key); leave it out so the case file stays numeric.
+    if (k == "time.dt" && std::holds_alternative<std::string>(v)) continue;
     auto dot = k.find('.');
     sections[k.substr(0, dot)] += k.substr(dot + 1) + " = " + value_to_text(v) + "\n";
   }

@@ -294,6 +294,12 @@ std::string Store::record_outcome(const std::string& case_id, std::int64_t attem
       status = outcome = (*j)["status"].get<std::string>();
       if (status == "unstable") error = reason_of(*j);
     }
+  } else if (out.signal == 0 && out.exit_code == 3 && parse_result_line(out.last_line) &&
+             mismatch(*parse_result_line(out.last_line), params).empty()) {
+    // Interrupted after the result was printed: the result stands.
+    j = parse_result_line(out.last_line);
+    status = outcome = (*j)["status"].get<std::string>();
+    if (status == "unstable") error = reason_of(*j);
   } else if (out.signal == 0 && out.exit_code == 3) {
     status = "queued";
     outcome = "interrupted";

@@ -1,0 +1,106 @@
+// Ca* interval and CaH from samples; adaptive refinement proposals.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "campaign/analysis/transitions.h"
+
+namespace capsim::campaign {
+namespace {
+
+std::vector<Sample> samples(const std::vector<double>& cas, double (*d12)(double), double (*tau)(double)) {
+  std::vector<Sample> out;
+  for (double ca : cas) out.push_back({ca, d12(ca), tau(ca), "id" + std::to_string(ca)});
+  return out;
+}
+
+double d12_oblate(double ca) { return 0.02 + 2.0 * std::fabs(ca - 0.03); }
+double tau_oblate(double ca) { return 0.70 - ca; }
+
+TEST(Transitions, CaStarIsTheSampledIntervalBelowThreshold) {
+  auto s = samples({0.05, 0.01, 0.02, 0.03, 0.04, 0.06}, d12_oblate, tau_oblate);  // unsorted on purpose
+  Transition t = analyse_group(Transition{}, s, 0.05);
+  ASSERT_TRUE(t.ca_star_low && t.ca_star_high);
+  EXPECT_DOUBLE_EQ(*t.ca_star_low, 0.02);
+  EXPECT_DOUBLE_EQ(*t.ca_star_high, 0.04);
+  EXPECT_DOUBLE_EQ(*t.ca_star_below, 0.01);
+  EXPECT_DOUBLE_EQ(*t.ca_star_above, 0.05);
+  EXPECT_DOUBLE_EQ(*t.ca_min_d12, 0.03);
+  EXPECT_EQ(t.n_samples, 6);
+  // A stricter threshold narrows it.
+  Transition u = analyse_group(Transition{}, s, 0.03);
+  EXPECT_DOUBLE_EQ(*u.ca_star_low, 0.03);
+  EXPECT_DOUBLE_EQ(*u.ca_star_high, 0.03);
+}
+
+TEST(Transitions, CaHIsInterpolatedBetweenTheBracketingSamples) {
+  auto s = samples({0.2, 0.4, 0.6, 1.0, 1.5}, d12_oblate, tau_oblate);
+  Transition t = analyse_group(Transition{}, s, 0.05);
+  ASSERT_TRUE(t.ca_h);
+  EXPECT_NEAR(*t.ca_h, 0.70, 1e-12);  // linear data: exact zero
+  EXPECT_DOUBLE_EQ(*t.ca_h_low, 0.6);
+  EXPECT_DOUBLE_EQ(*t.ca_h_high, 1.0);
+  EXPECT_EQ(t.ca_h_low_case, s[2].case_id);
+  // Nonlinear data: the linear zero lies inside the bracket, not at its middle.
+  s[2].max_tau_min = 0.3;
+  s[3].max_tau_min = -0.1;
+  t = analyse_group(Transition{}, s, 0.05);
+  EXPECT_NEAR(*t.ca_h, 0.6 + 0.4 * 0.75, 1e-12);
+}
+
+TEST(Transitions, CaHTakesTheLastSignChangeAndReportsMissingBrackets) {
+  auto s = samples({0.1, 0.2, 0.3, 0.4}, d12_oblate, tau_oblate);
+  s[0].max_tau_min = -0.1;  // negative at a small Ca, positive again above: the criterion is "above which"
+  s[1].max_tau_min = 0.2;
+  s[2].max_tau_min = -0.2;
+  s[3].max_tau_min = -0.3;
+  Transition t = analyse_group(Transition{}, s, 0.05);
+  EXPECT_NEAR(*t.ca_h, 0.2 + 0.1 * 0.5, 1e-12);
+  for (auto& x : s) x.max_tau_min = 1.0;
+  t = analyse_group(Transition{}, s, 0.05);
+  EXPECT_FALSE(t.ca_h);
+  EXPECT_NE(t.note.find("CaH above 0.4"), std::string::npos) << t.note;
+  for (auto& x : s) x.max_tau_min = -1.0;
+  t = analyse_group(Transition{}, s, 0.05);
+  EXPECT_FALSE(t.ca_h);
+  EXPECT_NE(t.note.find("CaH below 0.1"), std::string::npos) << t.note;
+}
+
+TEST(Transitions, NoSampleBelowThreshold) {
+  auto s = samples({0.1, 0.2}, d12_oblate, tau_oblate);
+  Transition t = analyse_group(Transition{}, s, 0.05);
+  EXPECT_FALSE(t.ca_star_low);
+  EXPECT_DOUBLE_EQ(*t.ca_min_d12, 0.1);
+  EXPECT_NE(t.note.find("never below"), std::string::npos);
+}
+
+TEST(Adaptive, ProposalsShrinkBracketsAndConverge) {
+  // Start coarse, add the proposals of each round: the Ca* edges and CaH converge to the tolerance.
+  std::vector<double> cas = {0.01, 0.1, 0.4, 0.8, 1.2};
+  const double tol = 0.005;
+  int rounds = 0;
+  for (; rounds < 30; ++rounds) {
+    auto s = samples(cas, d12_oblate, tau_oblate);
+    Transition t = analyse_group(Transition{}, s, 0.05);
+    auto add = propose_refinement(t, s, tol);
+    if (add.empty()) break;
+    for (double x : add) {
+      for (double y : cas) ASSERT_NE(x, y);
+      cas.push_back(x);
+    }
+  }
+  EXPECT_LT(rounds, 30);
+  auto s = samples(cas, d12_oblate, tau_oblate);
+  Transition t = analyse_group(Transition{}, s, 0.05);
+  ASSERT_TRUE(t.ca_star_low && t.ca_star_high && t.ca_h);
+  // True band: |Ca - 0.03| < 0.015, i.e. (0.015, 0.045).
+  EXPECT_LE(*t.ca_star_low - 0.015, tol);
+  EXPECT_GE(*t.ca_star_low, 0.015);
+  EXPECT_LE(0.045 - *t.ca_star_high, tol);
+  EXPECT_NEAR(*t.ca_h, 0.70, 1e-9);
+  EXPECT_LE(*t.ca_h_high - *t.ca_h_low, tol);
+  EXPECT_LT(cas.size(), 40u);  // a fixed 0.005 grid over [0.01, 1.2] would need 239 cases
+}
+
+}  // namespace
+}  // namespace capsim::campaign

@@ -1,0 +1,164 @@
+// Grid expansion (exact decimal ranges, unions, duplicates) and case identity stability.
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "campaign/common/bad_input.h"
+#include "campaign/grid/campaign_spec.h"
+#include "campaign/grid/decimal.h"
+#include "campaign/grid/sha256.h"
+
+namespace capsim::campaign {
+namespace {
+
+TEST(Decimal, RangeOfHundredthsHitsTheLiterals) {
+  auto pts = expand_decimal_range(Decimal::from_double(0.01), Decimal::from_double(0.10), Decimal::from_double(0.01));
+  ASSERT_EQ(pts.size(), 10u);
+  const double literals[] = {0.01, 0.02, 0.03, 0.04, 0.05, 0.06, 0.07, 0.08, 0.09, 0.10};
+  for (int i = 0; i < 10; ++i) EXPECT_EQ(pts[i].to_double(), literals[i]) << i;  // exact, no drift
+  EXPECT_EQ(pts[6].to_string(), "0.07");
+  EXPECT_EQ(pts[9].to_string(), "0.1");
+  // The naive floating loop drifts (0.1 + 0.1 + 0.1 != 0.3); the decimal range does not.
+  double x = 0.1;
+  for (int i = 0; i < 2; ++i) x += 0.1;
+  EXPECT_NE(x, 0.3);
+  auto tenths = expand_decimal_range(Decimal::from_double(0.1), Decimal::from_double(0.5), Decimal::from_double(0.1));
+  EXPECT_EQ(tenths.at(2).to_double(), 0.3);
+}
+
+TEST(Decimal, BadRanges) {
+  auto d = [](double x) { return Decimal::from_double(x); };
+  EXPECT_THROW(expand_decimal_range(d(0.1), d(0.05), d(0.01)), std::invalid_argument);
+  EXPECT_THROW(expand_decimal_range(d(0.1), d(0.2), d(0)), std::invalid_argument);
+  EXPECT_THROW(expand_decimal_range(d(0.1), d(0.2), d(-0.01)), std::invalid_argument);
+  EXPECT_THROW(expand_decimal_range(d(0.1), d(1.0), d(0.2)), std::invalid_argument);  // not a multiple
+  EXPECT_THROW(expand_decimal_range(d(0), d(1), d(1e-6)), std::invalid_argument);     // too many points
+  EXPECT_EQ(expand_decimal_range(d(0.5), d(0.5), d(0.1)).size(), 1u);
+  EXPECT_EQ(expand_decimal_range(d(1), d(3), d(1)).back().to_string(), "3");
+}
+
+TEST(Sha256, KnownVectors) {
+  EXPECT_EQ(sha256_hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(sha256_hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(sha256_hex(std::string(1000, 'a')).substr(0, 16), "41edece42d63e8d9");
+}
+
+const char* kSeedLike = R"(
+[campaign]
+name = "table1-quick"
+[defaults]
+mesh.level = 2
+capsule.skalak_C = 1.0
+[[grid]]
+aspect_ratio = [0.5]
+law = ["neo-hookean", "skalak"]
+capillary_number = { start = 0.01, stop = 0.10, step = 0.01 }
+[[grid]]
+aspect_ratio = [2.0]
+law = ["neo-hookean", "skalak"]
+capillary_number = [0.1, 0.2, 0.25, 0.3, 0.35, 0.5]
+[analysis]
+D12_threshold = 0.05
+)";
+
+TEST(Grid, ExpandsTheIssueExample) {
+  auto spec = parse_campaign(kSeedLike, "example.toml");
+  auto cases = expand_grid(spec);
+  EXPECT_EQ(cases.size(), 2u * 10 + 2u * 6);
+  std::set<std::string> ids;
+  for (const auto& c : cases) {
+    ids.insert(c.identity("v1"));
+    EXPECT_EQ(c.mesh_level(), 2);
+  }
+  EXPECT_EQ(ids.size(), cases.size());
+  std::set<double> nh_oblate;
+  for (const auto& c : cases)
+    if (c.law() == "neo-hookean" && c.aspect_ratio() == 0.5) nh_oblate.insert(c.capillary_number());
+  EXPECT_EQ(nh_oblate, (std::set<double>{0.01, 0.02, 0.03, 0.04, 0.05, 0.06, 0.07, 0.08, 0.09, 0.10}));
+  EXPECT_EQ(spec.analysis.d12_threshold, 0.05);
+}
+
+TEST(Grid, UnionRemovesDuplicatesAcrossBlocks) {
+  auto spec = parse_campaign(R"(
+[campaign]
+name = "dups"
+[[grid]]
+capillary_number = [0.1, 0.2, 0.1]
+[[grid]]
+capillary_number = { start = 0.2, stop = 0.4, step = 0.1 }
+aspect_ratio = [2]
+)", "dups.toml");
+  // Default a/b is 2.0, so block 2's 0.2 duplicates block 1's 0.2 (and "2" equals "2.0").
+  EXPECT_EQ(expand_grid(spec).size(), 4u);
+}
+
+CaseParams base() {
+  auto spec = parse_campaign(R"(
+[campaign]
+name = "one"
+[[grid]]
+capillary_number = [0.3]
+)", "one.toml");
+  return expand_grid(spec).at(0);
+}
+
+TEST(Identity, StableAndSensitiveToWhatMatters) {
+  const CaseParams p = base();
+  EXPECT_EQ(p.identity("abc"), base().identity("abc"));
+  EXPECT_EQ(p.identity("abc").size(), 16u);
+  // Pinned value: a change of canonical form would silently orphan every stored case.
+  EXPECT_EQ(p.canonical(),
+            "capsule.aspect_ratio=2.0\ncapsule.law=\"skalak\"\ncapsule.skalak_C=1.0\nflow.capillary_number=0.3\n"
+            "mesh.level=3\ntime.dt=\"auto\"\ntime.t_end=60.0\n");
+  // Changes that matter.
+  for (auto [k, v] : std::vector<std::pair<std::string, Value>>{{"flow.capillary_number", 0.31},
+                                                                {"capsule.aspect_ratio", 0.5},
+                                                                {"capsule.law", std::string("neo-hookean")},
+                                                                {"capsule.skalak_C", 2.0},
+                                                                {"mesh.level", std::int64_t{2}},
+                                                                {"time.t_end", 30.0},
+                                                                {"time.dt", 0.01}}) {
+    CaseParams q = p;
+    q.set(k, v);
+    EXPECT_NE(q.identity("abc"), p.identity("abc")) << k;
+  }
+  EXPECT_NE(p.identity("abc"), p.identity("abd"));  // solver version
+  // Changes that do not: output settings, how a number was typed.
+  CaseParams q = p;
+  q.set("output.snapshot_interval", 5.0);
+  EXPECT_EQ(q.identity("abc"), p.identity("abc"));
+  q.set("capsule.aspect_ratio", std::int64_t{2});
+  EXPECT_EQ(q.identity("abc"), p.identity("abc"));
+  // skalak_C is irrelevant for the neo-Hookean law.
+  CaseParams nh1 = p, nh2 = p;
+  nh1.set("capsule.law", std::string("neo-hookean"));
+  nh2.set("capsule.law", std::string("neo-hookean"));
+  nh2.set("capsule.skalak_C", 3.0);
+  EXPECT_EQ(nh1.identity("abc"), nh2.identity("abc"));
+}
+
+TEST(Identity, SameCaseInTwoCampaignsIsTheSameCase) {
+  auto a = expand_grid(parse_campaign("[campaign]\nname='a'\n[defaults]\nflow.capillary_number=0.2\n"
+                                      "[[grid]]\naspect_ratio=[0.5]\n", "a.toml"));
+  auto b = expand_grid(parse_campaign("[campaign]\nname='b'\n[defaults.capsule]\naspect_ratio=0.5\n"
+                                      "[[grid]]\ncapillary_number={start=0.1, stop=0.2, step=0.1}\n", "b.toml"));
+  ASSERT_EQ(a.size(), 1u);
+  ASSERT_EQ(b.size(), 2u);
+  EXPECT_EQ(a[0].identity(solver_version()), b[1].identity(solver_version()));
+}
+
+TEST(Identity, JsonRoundTripKeepsIdentity) {
+  CaseParams p = base();
+  p.set("mesh.spheroid_map", std::string("equal-arc-length"));
+  EXPECT_EQ(CaseParams::from_json(p.to_json()).identity("x"), p.identity("x"));
+  EXPECT_THROW(CaseParams::from_json("{\"mesh.lvl\": 2}"), BadInput);
+}
+
+TEST(Grid, CaseTomlHasSections) {
+  std::string t = base().to_toml();
+  EXPECT_NE(t.find("[flow]\ncapillary_number = 0.3\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("[mesh]\nlevel = 3\n"), std::string::npos) << t;
+}
+
+}  // namespace
+}  // namespace capsim::campaign

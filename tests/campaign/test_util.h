@@ -1,0 +1,104 @@
+#pragma once
+// Helpers of the campaign tests: temporary folders, running the capsim binary, file snapshots.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace capsim::campaign::testing {
+
+namespace fs = std::filesystem;
+
+inline std::string exe() { return CAPSIM_EXE_PATH; }
+inline std::string fake_worker() { return std::string(CAPSIM_SOURCE_DIR) + "/tests/campaign/fake_worker.sh"; }
+
+/// A fresh folder per test under CAPSIM_TEST_TMP.
+inline std::string fresh_dir(const std::string& name) {
+  fs::path p = fs::path(CAPSIM_TEST_TMP) / "campaign" / name;
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p.string();
+}
+
+inline std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+inline void write_file(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << text;
+}
+
+struct CmdResult {
+  int code = -1;
+  std::string out, err;
+};
+
+/// Runs a shell command line; captures stdout and stderr.
+inline CmdResult sh(const std::string& cmd) {
+  static int counter = 0;
+  const std::string base = std::string(CAPSIM_TEST_TMP) + "/campaign/sh_" + std::to_string(getpid()) + "_" +
+                           std::to_string(counter++);
+  fs::create_directories(std::string(CAPSIM_TEST_TMP) + "/campaign");
+  const std::string full = "(" + cmd + ") >" + base + ".out 2>" + base + ".err";
+  int st = std::system(full.c_str());
+  CmdResult r;
+  r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  r.out = read_file(base + ".out");
+  r.err = read_file(base + ".err");
+  fs::remove(base + ".out");
+  fs::remove(base + ".err");
+  return r;
+}
+
+/// Starts a shell command in the background; returns the pid of the exec'd program.
+inline pid_t spawn_sh(const std::string& cmd) {
+  pid_t pid = fork();
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+/// Waits for a child up to @p timeout_s; returns its exit code, -signal if signalled, -1000 on timeout.
+inline int wait_child(pid_t pid, double timeout_s) {
+  auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (std::chrono::steady_clock::now() < deadline) {
+    int st = 0;
+    pid_t r = waitpid(pid, &st, WNOHANG);
+    if (r == pid) return WIFEXITED(st) ? WEXITSTATUS(st) : -WTERMSIG(st);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return -1000;
+}
+
+/// A campaign command with the fake worker and extra environment.
+inline std::string campaign_cmd(const std::string& env, const std::string& file, const std::string& db,
+                                const std::string& extra = "") {
+  return "env " + env + " CAPSIM_WORKER=" + fake_worker() + " " + exe() + " campaign run " + file + " --db " + db + " " + extra;
+}
+
+/// Number of non-empty lines.
+inline int count_lines(const std::string& s) {
+  int n = 0;
+  std::istringstream in(s);
+  std::string line;
+  while (std::getline(in, line))
+    if (!line.empty()) ++n;
+  return n;
+}
+
+}  // namespace capsim::campaign::testing

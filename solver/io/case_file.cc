@@ -173,6 +173,9 @@ CaseWriter CaseWriter::resume(const std::filesystem::path& file, const std::vect
   impl->options.buffer_rows = std::max<std::size_t>(options.buffer_rows, 1);
   impl->f = open_file_checked(file, H5F_ACC_RDWR);
   check_case_format(impl->f.get(), file);
+  for (const auto& p : parameters)
+    for (const char* r : kReserved)
+      if (p.key == r) throw std::invalid_argument("case file parameter name '" + p.key + "' is reserved");
   for (const auto& p : parameters) h5::write_attribute(impl->f.get(), p, file);
   // Replace the series by the checkpoint's: shrink to 0 and append it again (the series is small).
   for (const auto& c : kColumns) h5::set_rows(impl->f.get(), ts(c.name), 0, 0, file);
@@ -200,7 +203,20 @@ CaseWriter CaseWriter::resume(const std::filesystem::path& file, const std::vect
 }
 
 CaseWriter::CaseWriter(CaseWriter&&) noexcept = default;
-CaseWriter& CaseWriter::operator=(CaseWriter&&) noexcept = default;
+CaseWriter& CaseWriter::operator=(CaseWriter&& other) noexcept {
+  // Close (and so write the buffered rows of) the file this writer held before taking the other one.
+  if (this != &other) {
+    if (impl_ && impl_->f.valid()) {
+      try {
+        close();
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "capsim: closing case file: %s\n", e.what());
+      }
+    }
+    impl_ = std::move(other.impl_);
+  }
+  return *this;
+}
 
 CaseWriter::~CaseWriter() {
   if (!impl_ || !impl_->f.valid()) return;

@@ -78,6 +78,7 @@ class CaseWriter {
   static CaseWriter resume(const std::filesystem::path& file, const std::vector<Attribute>& parameters,
                            const diagnostics::TimeSeries& series, const CaseFileOptions& options = {});
 
+  /// @brief Movable; a moved-from writer must not be used. Assigning over an open writer closes its file.
   CaseWriter(CaseWriter&&) noexcept;
   CaseWriter& operator=(CaseWriter&&) noexcept;
   /// @brief Closes the file (errors are reported on stderr; call close() to get them as exceptions).

@@ -178,5 +178,15 @@ TEST(CaseFile, ErrorsNameTheFile) {
   EXPECT_THROW(w.write_snapshot(0, 0, mesh, mesh.nodes, bad_size), std::invalid_argument);
 }
 
+TEST(CaseFile, AssigningOverAnOpenWriterWritesItsBufferedRows) {
+  const auto first = scratch("first.h5"), second = scratch("second.h5");
+  CaseWriter w(first, {}, {.buffer_rows = 64});
+  for (int i = 0; i < 10; ++i) w.append(record(i));  // still buffered
+  w = CaseWriter(second, {});
+  EXPECT_EQ(read_case_file(first).series.size(), 10u);
+  w.close();
+  EXPECT_EQ(read_case_file(second).series.size(), 0u);
+}
+
 }  // namespace
 }  // namespace capsim::io

@@ -1,0 +1,229 @@
+#include "solver/driver/case_driver.h"
+
+#include <chrono>
+#include <cmath>
+#include <optional>
+
+#include "capsim/version.h"
+#include "solver/diagnostics/material_point.h"
+#include "solver/diagnostics/time_series.h"
+#include "solver/dynamics/capsule_flow.h"
+#include "solver/dynamics/time_stepper.h"
+#include "solver/io/case_file.h"
+#include "solver/io/checkpoint.h"
+#include "solver/membrane/membrane_mechanics.h"
+#include "solver/mesh/p2_element.h"
+
+namespace capsim::driver {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Runaway velocity: the disturbance velocity of a capsule in unit shear is O(1); a hundred times the
+// extent of the capsule per unit time is no physical motion.
+constexpr double kMaxDisturbanceSpeed = 100.0;
+
+std::vector<io::Attribute> case_attributes(const config::CaseConfig& c) {
+  std::vector<io::Attribute> a;
+  a.emplace_back("capillary_number", c.capillary_number);
+  a.emplace_back("aspect_ratio", c.aspect_ratio);
+  a.emplace_back("law", c.law);
+  a.emplace_back("skalak_C", c.skalak_C);
+  a.emplace_back("mesh_level", c.level);
+  a.emplace_back("config_toml", c.to_toml());
+  return a;
+}
+
+// Outward unit normals at the nodes: average of the exact P2 normals of the elements around each node.
+Eigen::Matrix3Xd node_normals(const mesh::SurfaceMesh& m, const Eigen::Matrix3Xd& x) {
+  static constexpr double local[6][2] = {{0, 0}, {1, 0}, {0, 1}, {0.5, 0}, {0.5, 0.5}, {0, 0.5}};
+  Eigen::Matrix3Xd n = Eigen::Matrix3Xd::Zero(3, x.cols());
+  for (const auto& el : m.elements)
+    for (int k = 0; k < 6; ++k) {
+      const auto dN = mesh::p2_shape_gradients(local[k][0], local[k][1]);
+      Eigen::Vector3d g1 = Eigen::Vector3d::Zero(), g2 = Eigen::Vector3d::Zero();
+      for (int a = 0; a < 6; ++a) {
+        g1 += dN[0][a] * x.col(el[a]);
+        g2 += dN[1][a] * x.col(el[a]);
+      }
+      n.col(el[k]) += g1.cross(g2).normalized();
+    }
+  n.colwise().normalize();
+  return n;
+}
+
+void write_snapshot(io::CaseWriter& writer, dynamics::CapsuleFlow& flow, const Eigen::Matrix3Xd& x, double t,
+                    long step) {
+  Eigen::Matrix3Xd v, q;
+  flow.velocity(x, v, &q);
+  const Eigen::Matrix3Xd n = node_normals(flow.mesh(), x);
+  const Eigen::VectorXd qn = (q.array() * n.array()).colwise().sum().transpose();
+  const io::NodeField fields[] = {io::NodeField::scalar("q_n", qn), io::NodeField::vector("q", q),
+                                  io::NodeField::vector("velocity", v)};
+  writer.write_snapshot(t, step, flow.mesh(), x, fields);
+}
+
+}  // namespace
+
+CaseResult run_case(const config::CaseConfig& config, const RunOptions& options) {
+  const auto wall0 = Clock::now();
+  config.validate();
+  std::filesystem::create_directories(options.out_dir);
+  const auto case_file = options.out_dir / "case.h5";
+  const auto checkpoint_file = options.out_dir / "checkpoint.h5";
+
+  // --- Set up: mesh, membrane, load solver, boundary-integral operator.
+  dynamics::CapsuleFlow flow(config);
+  const auto& mesh = flow.mesh();
+  const double dt = config.dt ? *config.dt
+                              : dynamics::automatic_time_step(mesh, config.capillary_number, config.dt_factor);
+  const double V0 = membrane::area_and_volume(mesh, flow.reference()).volume;
+  Eigen::Matrix3Xd x = flow.reference();
+  double t = 0.0;
+  long step = 0;
+  diagnostics::TimeSeries series;
+  int p_node = diagnostics::choose_material_point(mesh, x);
+  const std::string identity = config.to_toml();
+
+  std::optional<io::CaseWriter> writer;
+  if (options.resume && std::filesystem::exists(checkpoint_file)) {
+    io::Checkpoint cp = io::read_checkpoint(checkpoint_file);
+    if (cp.strings["case"] != identity || cp.positions.cols() != mesh.num_nodes())
+      throw config::ConfigError(checkpoint_file.string() + ": checkpoint belongs to another case (parameters differ)");
+    x = cp.positions;
+    t = cp.time;
+    step = cp.step;
+    series = cp.series;
+    p_node = static_cast<int>(cp.scalars["p_node"]);
+    writer.emplace(io::CaseWriter::resume(case_file, case_attributes(config), series));
+  } else {
+    writer.emplace(case_file, case_attributes(config));
+  }
+
+  auto save_checkpoint = [&](const Eigen::Matrix3Xd& state, double time, long steps) {
+    io::Checkpoint cp;
+    cp.positions = state;
+    cp.time = time;
+    cp.step = steps;
+    cp.dt = dt;
+    cp.series = series;
+    cp.scalars["p_node"] = p_node;
+    cp.strings["case"] = identity;
+    io::write_checkpoint(checkpoint_file, cp);
+  };
+
+  // --- March in time.
+  CaseResult r;
+  r.dt = dt;
+  dynamics::Rk2Integrator rk;
+  Eigen::Matrix3Xd last_good;
+  const double h_min = mesh::min_node_spacing(mesh, x);
+  const double eps = 1e-9 * dt;
+  double next_check = t + config.check_interval;
+  double next_checkpoint = config.checkpoint_interval > 0 ? t + config.checkpoint_interval : INFINITY;
+  double next_snapshot = config.snapshot_interval > 0 ? t : INFINITY;
+  double next_sample = t;
+  auto last_progress = Clock::now();
+  diagnostics::ConvergenceOptions conv;
+  conv.tol_D12 = conv.tol_tau_min = config.period_tolerance;
+
+  while (true) {
+    if (options.stop_requested && options.stop_requested->load()) {
+      save_checkpoint(x, t, step);
+      r.status = "interrupted";
+      r.reason = "stop requested at t = " + std::to_string(t) + "; resume continues from the checkpoint";
+      break;
+    }
+    if (t >= config.t_end - eps) {
+      r.status = "done";
+      break;
+    }
+    if (t >= next_snapshot - eps) {
+      write_snapshot(*writer, flow, x, t, step);
+      next_snapshot += config.snapshot_interval;
+    }
+    diagnostics::StepRecord rec = diagnostics::measure_step(mesh, x, t, p_node, 0.0);
+    last_good = x;
+    dynamics::StepInfo info;
+    std::string failure;
+    try {
+      info = rk.step(flow, x, dt);
+    } catch (const membrane::DegenerateSurface& e) {
+      failure = e.what();
+    }
+    if (failure.empty()) {
+      if (!x.allFinite()) failure = "non-finite positions";
+      else if (!std::isfinite(info.start.max_speed) || info.start.max_speed > kMaxDisturbanceSpeed)
+        failure = "runaway velocity |v - v_inf| = " + std::to_string(info.start.max_speed);
+      else if (info.max_displacement > 0.5 * h_min)
+        failure = "node displacement " + std::to_string(info.max_displacement) + " in one step exceeds h_min/2";
+      else if (std::abs(rec.volume - V0) > config.volume_tolerance * V0)
+        failure = "volume changed by " + std::to_string(100.0 * (rec.volume - V0) / V0) + "%";
+    }
+    if (!failure.empty()) {
+      x = last_good;
+      r.status = "unstable";
+      r.reason = failure + " at t = " + std::to_string(t);
+      save_checkpoint(x, t, step);
+      writer->write_snapshot(t, step, mesh, x);
+      break;
+    }
+    rec.tau_min = info.start.tau_min;
+    if (t >= next_sample - eps) {
+      series.push_back(rec);
+      writer->append(rec);
+      next_sample += config.sample_interval;
+    }
+    ++step;
+    t = step * dt;  // no drift from repeated additions
+
+    if (t >= next_check - eps) {
+      next_check += config.check_interval;
+      r.analysis = diagnostics::analyse_periods(series);
+      if (diagnostics::periodic_regime_converged(r.analysis, conv)) {
+        r.converged = true;
+        r.status = "done";
+        break;
+      }
+    }
+    if (t >= next_checkpoint - eps) {
+      writer->flush();
+      save_checkpoint(x, t, step);
+      next_checkpoint += config.checkpoint_interval;
+    }
+    if (options.progress && Clock::now() - last_progress > std::chrono::seconds(1)) {
+      last_progress = Clock::now();
+      options.progress({t, config.t_end, step, rec.D12, rec.tau_min,
+                        std::chrono::duration<double>(Clock::now() - wall0).count()});
+    }
+  }
+
+  // --- Output: final analysis and summary attributes.
+  if (!series.empty()) r.analysis = diagnostics::analyse_periods(series);
+  const double V = membrane::area_and_volume(mesh, x).volume;
+  r.volume_drift = (V - V0) / V0;
+  r.steps = step;
+  r.t_final = t;
+  r.flow_evaluations = flow.timings().evaluations;
+  r.membrane_s = flow.timings().membrane_s;
+  r.load_s = flow.timings().load_s;
+  r.stokes_s = flow.timings().stokes_s;
+  r.case_file = case_file;
+  if (r.status == "done") save_checkpoint(x, t, step);
+  writer->set_attribute({"status", r.status});
+  writer->set_attribute({"reason", r.reason});
+  writer->set_attribute({"regime", std::string(diagnostics::to_string(r.analysis.regime))});
+  writer->set_attribute({"min_D12", r.analysis.min_D12});
+  writer->set_attribute({"max_tau_min", r.analysis.max_tau_min});
+  writer->set_attribute({"mean_D12", r.analysis.mean_D12});
+  writer->set_attribute({"period", r.analysis.period});
+  writer->set_attribute({"volume_drift", r.volume_drift});
+  writer->set_attribute({"steps", r.steps});
+  writer->set_attribute({"dt", r.dt});
+  writer->set_attribute({"t_final", r.t_final});
+  writer->close();
+  r.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
+  return r;
+}
+
+}  // namespace capsim::driver

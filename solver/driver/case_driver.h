@@ -1,0 +1,56 @@
+#pragma once
+/// @file
+/// @brief One capsule case end to end, in the phases of the method: set up (mesh, law, operators), march
+/// in time (RK2 on dx/dt = v(x)) with per-step diagnostics, stop on a converged periodic regime, a blow-up,
+/// an interrupt or t_end, and output (HDF5 time series, snapshots, checkpoint, summary).
+
+#include <atomic>
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "solver/config/case_config.h"
+#include "solver/diagnostics/period_analysis.h"
+
+namespace capsim::driver {
+
+/// @brief Progress report, sent about once per second of wall time.
+struct Progress {
+  double t = 0, t_end = 0;
+  long step = 0;
+  double D12 = 0, tau_min = 0;
+  double wall_s = 0;
+};
+
+/// @brief How to run (not what: that is the CaseConfig).
+struct RunOptions {
+  std::filesystem::path out_dir = ".";      ///< case.h5, case.xmf, checkpoint.h5 go here
+  bool resume = false;                      ///< continue from out_dir/checkpoint.h5 if it exists
+  std::function<void(const Progress&)> progress;  ///< optional
+  const std::atomic<bool>* stop_requested = nullptr;  ///< set asynchronously (signals): checkpoint and return
+};
+
+/// @brief Outcome of a case. `status`: "done" (t_end reached or periodic regime converged), "unstable"
+/// (numerical blow-up; `reason` says which test fired, the last good state is in the case file and the
+/// checkpoint), "interrupted" (stop requested; the checkpoint lets `resume` continue exactly).
+struct CaseResult {
+  std::string status;
+  std::string reason;
+  bool converged = false;            ///< periodic (or steady) regime reached before t_end
+  diagnostics::PeriodAnalysis analysis;
+  double volume_drift = 0;           ///< (V(t_final) − V0)/V0
+  long steps = 0;
+  long flow_evaluations = 0;
+  double dt = 0;
+  double t_final = 0;
+  double wall_s = 0;
+  double membrane_s = 0, load_s = 0, stokes_s = 0;  ///< wall time of the phases
+  std::filesystem::path case_file;
+};
+
+/// @brief Run one case.
+/// @throws config::ConfigError for bad input (e.g. a checkpoint of another case), io::IoError for output
+/// problems. Numerical blow-ups are results (status "unstable"), not exceptions.
+CaseResult run_case(const config::CaseConfig& config, const RunOptions& options);
+
+}  // namespace capsim::driver

@@ -10,6 +10,7 @@
 
 #include "campaign/common/bad_input.h"
 #include "campaign/grid/decimal.h"
+#include "solver/config/case_config.h"
 
 namespace capsim::campaign {
 
@@ -305,8 +306,19 @@ std::vector<CaseParams> expand_grid(const CampaignSpec& spec) {
     std::vector<std::size_t> idx(block.axes.size(), 0);
     while (true) {
       CaseParams p = spec.defaults;
-      for (std::size_t a = 0; a < block.axes.size(); ++a) p.set(block.axes[a].key, block.axes[a].values[idx[a]]);
-      if (seen.insert(p.identity(version)).second) out.push_back(std::move(p));
+      std::string point;
+      for (std::size_t a = 0; a < block.axes.size(); ++a) {
+        p.set(block.axes[a].key, block.axes[a].values[idx[a]]);
+        point += (a ? ", " : "") + block.axes[a].key + "=" + value_to_text(block.axes[a].values[idx[a]]);
+      }
+      std::string id;
+      try {
+        id = p.identity(version);
+      } catch (const config::ConfigError& e) {
+        throw BadInput(spec.source + ": [grid][" + std::to_string(&block - spec.grids.data() + 1) + "] case " +
+                       point + ": rejected by the solver: " + e.what());
+      }
+      if (seen.insert(id).second) out.push_back(std::move(p));
       // Odometer increment, last axis fastest.
       std::size_t a = block.axes.size();
       while (a > 0) {

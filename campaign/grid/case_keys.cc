@@ -18,7 +18,15 @@ const std::vector<CaseKey>& case_keys() {
       {"time.t_end", KeyType::kFloat, Value{60.0}, true, "hard cap on simulated time (1/shear rate), > 0"},
       {"time.dt", KeyType::kFloatOrAuto, Value{std::string("auto")}, true, "\"auto\" or a time step > 0"},
       {"time.dt_factor", KeyType::kFloat, std::nullopt, true, "safety factor on the automatic time step, > 0"},
+      {"time.period_tolerance", KeyType::kFloat, std::nullopt, true, "periodic-regime stop tolerance, > 0"},
+      {"time.check_interval", KeyType::kFloat, std::nullopt, true, "time between periodic-regime checks, > 0"},
+      {"time.volume_tolerance", KeyType::kFloat, std::nullopt, true, "relative volume change counted as blow-up"},
+      {"numerics.regular_degree", KeyType::kInt, std::nullopt, true, "boundary-integral triangle rule: 4, 5, 6"},
+      {"numerics.duffy_order", KeyType::kInt, std::nullopt, true, "Gauss points per direction, singular integrals"},
+      {"numerics.membrane_degree", KeyType::kInt, std::nullopt, true, "membrane/mass-matrix triangle rule: 4, 5, 6"},
       {"output.snapshot_interval", KeyType::kFloat, Value{0.0}, false, "time between snapshots, 0 = none"},
+      {"output.checkpoint_interval", KeyType::kFloat, std::nullopt, false, "time between checkpoints"},
+      {"output.sample_interval", KeyType::kFloat, std::nullopt, true, "time-series sampling (0 = every step)"},
   };
   return keys;
 }
@@ -67,7 +75,11 @@ std::string check_case_value(const CaseKey& key, const Value& value) {
   } else if (n == "time.dt") {
     if (auto* s = std::get_if<std::string>(&value); s && *s != "auto") return "must be \"auto\" or a number > 0";
     if (auto x = num(); x && !(*x > 0)) return "must be > 0 (got " + value_to_text(value) + ")";
-  } else if (n == "output.snapshot_interval") {
+  } else if (n == "time.period_tolerance" || n == "time.check_interval") {
+    if (auto x = num(); x && !(*x > 0)) return "must be > 0 (got " + value_to_text(value) + ")";
+  } else if (n == "time.volume_tolerance") {
+    if (auto x = num(); x && !(*x > 0 && *x < 1)) return "must be in (0, 1) (got " + value_to_text(value) + ")";
+  } else if (n == "output.snapshot_interval" || n == "output.checkpoint_interval" || n == "output.sample_interval") {
     if (auto x = num(); x && *x < 0) return "must be >= 0 (got " + value_to_text(value) + ")";
   }
   return "";

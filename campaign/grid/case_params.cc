@@ -6,6 +6,7 @@
 #include "campaign/common/bad_input.h"
 #include "campaign/grid/sha256.h"
 #include "capsim/version.h"
+#include "solver/config/case_config.h"
 
 namespace capsim::campaign {
 
@@ -62,17 +63,16 @@ std::string CaseParams::law() const {
 }
 
 std::string CaseParams::canonical() const {
+  // The solver resolves every default, so an explicit default and an unset key give the same identity,
+  // and numbers are canonical however they were typed (2 and 2.0).
+  const auto resolved = config::parse_case_config(to_toml(), "case " + to_json()).to_map();
   const bool neo = law() == "neo-hookean";
   std::string out;
-  for (const auto& [k, v] : values_) {
+  for (const auto& [k, v] : resolved) {
     const CaseKey* key = find_case_key(k);
     if (key && !key->in_identity) continue;
     if (neo && k == "capsule.skalak_C") continue;
-    // Numbers are canonical regardless of how they were typed: 2 and 2.0 are the same aspect ratio.
-    Value canon = v;
-    if (key && (key->type == KeyType::kFloat || key->type == KeyType::kFloatOrAuto))
-      if (auto* i = std::get_if<std::int64_t>(&v)) canon = static_cast<double>(*i);
-    out += k + "=" + value_to_text(canon) + "\n";
+    out += k + "=" + v + "\n";
   }
   return out;
 }

@@ -39,8 +39,10 @@ class CaseParams {
   /// @brief time.t_end.
   double t_end() const;
 
-  /// @brief Canonical text of the parameters that change results: sorted "key=value" lines, keys with
-  /// in_identity=false left out, capsule.skalak_C left out for the neo-Hookean law.
+  /// @brief Canonical text of the parameters that change results: the solver's own resolved configuration
+  /// (capsim::config::CaseConfig::to_map(), every default explicit) as sorted "key=value" lines, output
+  /// keys that do not change results (snapshot/checkpoint intervals) left out, capsule.skalak_C left out for
+  /// the neo-Hookean law. @throws capsim::config::ConfigError if the solver rejects the case.
   std::string canonical() const;
   /// @brief Case identity: first 16 hex digits of SHA-256(canonical() + "solver=" + version).
   std::string identity(const std::string& version) const;

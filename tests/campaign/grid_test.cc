@@ -106,10 +106,18 @@ TEST(Identity, StableAndSensitiveToWhatMatters) {
   const CaseParams p = base();
   EXPECT_EQ(p.identity("abc"), base().identity("abc"));
   EXPECT_EQ(p.identity("abc").size(), 16u);
-  // Pinned value: a change of canonical form would silently orphan every stored case.
-  EXPECT_EQ(p.canonical(),
-            "capsule.aspect_ratio=2.0\ncapsule.law=\"skalak\"\ncapsule.skalak_C=1.0\nflow.capillary_number=0.3\n"
-            "mesh.level=3\ntime.dt=\"auto\"\ntime.t_end=60.0\n");
+  // The canonical form is the solver's resolved configuration: every result-changing key, no output keys.
+  const std::string canon = p.canonical();
+  for (const char* k : {"capsule.aspect_ratio=", "capsule.law=", "capsule.skalak_C=", "flow.capillary_number=",
+                        "mesh.level=3\n", "time.t_end=", "time.dt=", "time.dt_factor="})
+    EXPECT_NE(canon.find(k), std::string::npos) << k << " in " << canon;
+  EXPECT_EQ(canon.find("output.snapshot_interval"), std::string::npos) << canon;
+  EXPECT_EQ(canon.find("output.checkpoint_interval"), std::string::npos) << canon;
+  // An explicit default is the same case as an unset key.
+  CaseParams explicit_default = p;
+  explicit_default.set("time.dt_factor", 0.5);
+  explicit_default.set("numerics.regular_degree", std::int64_t{4});
+  EXPECT_EQ(explicit_default.identity("abc"), p.identity("abc"));
   // Changes that matter.
   for (auto [k, v] : std::vector<std::pair<std::string, Value>>{{"flow.capillary_number", 0.31},
                                                                 {"capsule.aspect_ratio", 0.5},
@@ -117,7 +125,9 @@ TEST(Identity, StableAndSensitiveToWhatMatters) {
                                                                 {"capsule.skalak_C", 2.0},
                                                                 {"mesh.level", std::int64_t{2}},
                                                                 {"time.t_end", 30.0},
-                                                                {"time.dt", 0.01}}) {
+                                                                {"time.dt", 0.01},
+                                                                {"time.dt_factor", 0.25},
+                                                                {"numerics.regular_degree", std::int64_t{6}}}) {
     CaseParams q = p;
     q.set(k, v);
     EXPECT_NE(q.identity("abc"), p.identity("abc")) << k;
@@ -145,6 +155,17 @@ TEST(Identity, SameCaseInTwoCampaignsIsTheSameCase) {
   ASSERT_EQ(a.size(), 1u);
   ASSERT_EQ(b.size(), 2u);
   EXPECT_EQ(a[0].identity(solver_version()), b[1].identity(solver_version()));
+}
+
+TEST(Grid, CasesTheSolverRejectsAreBadInput) {
+  try {
+    expand_grid(parse_campaign("[campaign]\nname='x'\n[defaults]\nmesh.spheroid_map='bogus'\n"
+                               "[[grid]]\ncapillary_number=[0.1]\n", "x.toml"));
+    FAIL() << "expected BadInput";
+  } catch (const BadInput& e) {
+    EXPECT_NE(std::string(e.what()).find("x.toml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("spheroid_map"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Identity, JsonRoundTripKeepsIdentity) {

@@ -48,6 +48,8 @@ std::vector<Bad> bad_files() {
        "D12_threshold"},
       {"missing name", "[campaign]\n[[grid]]\ncapillary_number = [0.1]\n", "name"},
       {"TOML syntax error", head + "[[grid]]\ncapillary_number = [0.1,\n", "TOML syntax"},
+      {"value the solver rejects", head + "[defaults]\nmesh.spheroid_map = \"bogus\"\n[[grid]]\ncapillary_number = [0.1]\n",
+       "spheroid_map"},
       {"axis twice", head + "[[grid]]\nlaw = [\"skalak\"]\ncapsule.law = [\"skalak\"]\n", "twice"},
   };
 }

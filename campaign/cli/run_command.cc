@@ -15,6 +15,7 @@
 #include "solver/config/case_config.h"
 #include "solver/driver/case_driver.h"
 #include "solver/io/io_error.h"
+#include "solver/solver_version.h"
 
 namespace capsim::cli {
 namespace {
@@ -43,6 +44,10 @@ int run_command(const std::vector<std::string>& args) {
   app.add_flag("--resume", resume, "continue from OUT/checkpoint.h5 if present");
   app.add_flag("--json", json, "print a JSON summary as the last stdout line");
   app.add_flag("--quiet", quiet, "no configuration echo or progress on stderr");
+  long stop_after = 0;
+  app.add_option("--stop-after", stop_after,
+                 "checkpoint and stop (exit 3) after this many steps of this invocation, as if interrupted")
+      ->check(CLI::NonNegativeNumber);
   std::vector<std::string> rev(args.rbegin(), args.rend());
   try {
     app.parse(rev);
@@ -79,6 +84,7 @@ int run_command(const std::vector<std::string>& args) {
   opt.out_dir = out_dir;
   opt.resume = resume;
   opt.stop_requested = &g_stop;
+  opt.stop_after_steps = stop_after;
   if (!quiet)
     opt.progress = [](const driver::Progress& p) {
       std::fprintf(stderr, "t = %8.3f / %g  step %7ld  D12 = %.4f  tau_min = %+.4f  wall %.0f s\n", p.t, p.t_end,
@@ -131,6 +137,7 @@ int run_command(const std::vector<std::string>& args) {
         {"threads", omp_get_max_threads()},
         {"case_file", std::filesystem::absolute(r.case_file).string()},
         {"code_version", kGitCommit},
+        {"solver_version", kSolverVersion},
     };
     std::printf("%s\n", j.dump().c_str());
     std::fflush(stdout);

@@ -7,10 +7,11 @@
 #include "campaign/grid/sha256.h"
 #include "capsim/version.h"
 #include "solver/config/case_config.h"
+#include "solver/solver_version.h"
 
 namespace capsim::campaign {
 
-std::string solver_version() { return kGitCommit; }
+std::string solver_version() { return kSolverVersion; }
 
 CaseParams CaseParams::defaults() {
   CaseParams p;

@@ -9,8 +9,9 @@
 
 namespace capsim::campaign {
 
-/// @brief Solver version that enters case identities: capsim::kGitCommit as built (a "-dirty" suffix is
-/// kept, so results of a modified tree never mix with those of the clean commit).
+/// @brief Solver version that enters case identities: capsim::kSolverVersion (solver/solver_version.h), bumped
+/// whenever the solver's numerical results change. Not the git commit: a commit that only touches docs or the
+/// campaign layer must not invalidate a finished study. Each result still records its exact code_version.
 std::string solver_version();
 
 /// @brief All case keys of one case (defaults filled in), as a sorted map of dotted key -> value.

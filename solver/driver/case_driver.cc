@@ -75,8 +75,7 @@ CaseResult run_case(const config::CaseConfig& config, const RunOptions& options)
   // --- Set up: mesh, membrane, load solver, boundary-integral operator.
   dynamics::CapsuleFlow flow(config);
   const auto& mesh = flow.mesh();
-  const double dt = config.dt ? *config.dt
-                              : dynamics::automatic_time_step(mesh, config.capillary_number, config.dt_factor);
+  const double dt = config.dt ? *config.dt : dynamics::automatic_time_step(config, mesh);
   const double V0 = membrane::area_and_volume(mesh, flow.reference()).volume;
   Eigen::Matrix3Xd x = flow.reference();
   double t = 0.0;
@@ -115,20 +114,26 @@ CaseResult run_case(const config::CaseConfig& config, const RunOptions& options)
   // --- March in time.
   CaseResult r;
   r.dt = dt;
-  dynamics::Rk2Integrator rk;
+  const std::unique_ptr<dynamics::TimeIntegrator> integrator = dynamics::make_integrator(config.scheme);
   Eigen::Matrix3Xd last_good;
   const double h_min = mesh::min_node_spacing(mesh, x);
   const double eps = 1e-9 * dt;
-  double next_check = t + config.check_interval;
-  double next_checkpoint = config.checkpoint_interval > 0 ? t + config.checkpoint_interval : INFINITY;
-  double next_snapshot = config.snapshot_interval > 0 ? t : INFINITY;
-  double next_sample = t;
+  // Every periodic action sits on a fixed grid of times (multiples of its interval), so a run resumed from a
+  // checkpoint checks, samples and saves at exactly the times an uninterrupted run does.
+  auto at_or_after = [&](double interval) { return interval > 0 ? std::ceil(t / interval - 1e-9) * interval : INFINITY; };
+  auto after = [&](double interval) { return interval > 0 ? (std::floor(t / interval + 1e-9) + 1.0) * interval : INFINITY; };
+  double next_check = after(config.check_interval);
+  double next_checkpoint = after(config.checkpoint_interval);
+  double next_snapshot = at_or_after(config.snapshot_interval);
+  double next_sample = config.sample_interval > 0 ? at_or_after(config.sample_interval) : t;
+  const long first_step = step;
   auto last_progress = Clock::now();
   diagnostics::ConvergenceOptions conv;
   conv.tol_D12 = conv.tol_tau_min = config.period_tolerance;
 
   while (true) {
-    if (options.stop_requested && options.stop_requested->load()) {
+    if ((options.stop_requested && options.stop_requested->load()) ||
+        (options.stop_after_steps > 0 && step - first_step >= options.stop_after_steps)) {
       save_checkpoint(x, t, step);
       r.status = "interrupted";
       r.reason = "stop requested at t = " + std::to_string(t) + "; resume continues from the checkpoint";
@@ -147,7 +152,7 @@ CaseResult run_case(const config::CaseConfig& config, const RunOptions& options)
     dynamics::StepInfo info;
     std::string failure;
     try {
-      info = rk.step(flow, x, dt);
+      info = integrator->step(flow, x, dt);
     } catch (const membrane::DegenerateSurface& e) {
       failure = e.what();
     }
@@ -155,8 +160,9 @@ CaseResult run_case(const config::CaseConfig& config, const RunOptions& options)
       if (!x.allFinite()) failure = "non-finite positions";
       else if (!std::isfinite(info.start.max_speed) || info.start.max_speed > kMaxDisturbanceSpeed)
         failure = "runaway velocity |v - v_inf| = " + std::to_string(info.start.max_speed);
-      else if (info.max_displacement > 0.5 * h_min)
-        failure = "node displacement " + std::to_string(info.max_displacement) + " in one step exceeds h_min/2";
+      else if (info.max_distortion > 0.5 * h_min)
+        failure = "relative displacement of neighbouring nodes " + std::to_string(info.max_distortion) +
+                  " in one step exceeds h_min/2";
       else if (std::abs(rec.volume - V0) > config.volume_tolerance * V0)
         failure = "volume changed by " + std::to_string(100.0 * (rec.volume - V0) / V0) + "%";
     }

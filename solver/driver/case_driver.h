@@ -28,6 +28,7 @@ struct RunOptions {
   bool resume = false;                      ///< continue from out_dir/checkpoint.h5 if it exists
   std::function<void(const Progress&)> progress;  ///< optional
   const std::atomic<bool>* stop_requested = nullptr;  ///< set asynchronously (signals): checkpoint and return
+  long stop_after_steps = 0;  ///< > 0: behave as if interrupted after this many steps of this invocation
 };
 
 /// @brief Outcome of a case. `status`: "done" (t_end reached or periodic regime converged), "unstable"

@@ -1,0 +1,12 @@
+#pragma once
+/// @file
+/// @brief Version of the numerical results of the solver, the part of a case's identity that says "same
+/// code answer". Bump it in any change that alters what `capsim run` computes (method, defaults that enter
+/// the results, bug fixes in the physics); do not bump it for documentation, the campaign layer or speed-ups
+/// that leave results unchanged to round-off. The exact build (git commit) is recorded separately on every
+/// result as code_version, so provenance is never lost.
+
+namespace capsim {
+/// @brief Numerical-results version of the solver.
+inline constexpr const char* kSolverVersion = "1";
+}  // namespace capsim

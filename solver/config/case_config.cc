@@ -52,6 +52,7 @@ const std::vector<KeySpec>& key_specs() {
       {"mesh", "level", [](auto& n, auto& c, auto& w) { c.level = as_int(n, w); }},
       {"mesh", "spheroid_map", [](auto& n, auto& c, auto& w) { c.spheroid_map = as_string(n, w); }},
       {"time", "t_end", [](auto& n, auto& c, auto& w) { c.t_end = as_number(n, w); }},
+      {"time", "scheme", [](auto& n, auto& c, auto& w) { c.scheme = as_string(n, w); }},
       {"time", "dt",
        [](auto& n, auto& c, auto& w) {
          if (auto s = n.template value_exact<std::string>()) {
@@ -62,6 +63,7 @@ const std::vector<KeySpec>& key_specs() {
          }
        }},
       {"time", "dt_factor", [](auto& n, auto& c, auto& w) { c.dt_factor = as_number(n, w); }},
+      {"time", "dt_accuracy", [](auto& n, auto& c, auto& w) { c.dt_accuracy = as_number(n, w); }},
       {"time", "period_tolerance", [](auto& n, auto& c, auto& w) { c.period_tolerance = as_number(n, w); }},
       {"time", "check_interval", [](auto& n, auto& c, auto& w) { c.check_interval = as_number(n, w); }},
       {"time", "volume_tolerance", [](auto& n, auto& c, auto& w) { c.volume_tolerance = as_number(n, w); }},
@@ -140,7 +142,10 @@ void CaseConfig::validate() const {
   }
   require(std::isfinite(t_end) && t_end > 0.0, "time.t_end", t_end, "must be > 0");
   if (dt) require(std::isfinite(*dt) && *dt > 0.0, "time.dt", *dt, "must be > 0 or \"auto\"");
+  if (scheme != "rk2" && scheme != "rkc")
+    throw ConfigError("time.scheme = \"" + scheme + "\" is not known (choose \"rk2\" or \"rkc\")");
   require(std::isfinite(dt_factor) && dt_factor > 0.0, "time.dt_factor", dt_factor, "must be > 0");
+  require(std::isfinite(dt_accuracy) && dt_accuracy > 0.0, "time.dt_accuracy", dt_accuracy, "must be > 0");
   require(period_tolerance > 0.0, "time.period_tolerance", period_tolerance, "must be > 0");
   require(check_interval > 0.0, "time.check_interval", check_interval, "must be > 0");
   require(volume_tolerance > 0.0 && volume_tolerance < 1.0, "time.volume_tolerance", volume_tolerance, "0 < v < 1");
@@ -161,8 +166,10 @@ std::map<std::string, std::string> CaseConfig::to_map() const {
       {"mesh.level", std::to_string(level)},
       {"mesh.spheroid_map", "\"" + spheroid_map + "\""},
       {"time.t_end", fmt_double(t_end)},
+      {"time.scheme", "\"" + scheme + "\""},
       {"time.dt", dt ? fmt_double(*dt) : "\"auto\""},
       {"time.dt_factor", fmt_double(dt_factor)},
+      {"time.dt_accuracy", fmt_double(dt_accuracy)},
       {"time.period_tolerance", fmt_double(period_tolerance)},
       {"time.check_interval", fmt_double(check_interval)},
       {"time.volume_tolerance", fmt_double(volume_tolerance)},

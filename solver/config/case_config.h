@@ -30,8 +30,10 @@ struct CaseConfig {
   std::string spheroid_map = "equal-arc-length";
   // [time]
   double t_end = 60.0;                 ///< hard cap, units of 1/γ̇
-  std::optional<double> dt;            ///< fixed time step; unset = automatic (dt = dt_factor · Ca · h_min)
-  double dt_factor = 0.5;              ///< stability safety constant c of the automatic dt (see dynamics)
+  std::string scheme = "rkc";          ///< time integrator: "rkc" (stabilised Runge–Kutta–Chebyshev) | "rk2" (Heun)
+  std::optional<double> dt;            ///< fixed time step; unset = automatic (see dynamics::automatic_time_step)
+  double dt_factor = 0.25;             ///< stability constant c of the automatic rk2 dt (measured limit ≈ 0.34–0.39)
+  double dt_accuracy = 0.02;           ///< automatic dt of rkc (accuracy-limited), never below the rk2 dt
   double period_tolerance = 2e-3;      ///< stop when successive periods agree to this (min D12, max τmin)
   double check_interval = 1.0;         ///< how often (time units) the periodic-regime test runs
   double volume_tolerance = 0.05;      ///< relative volume change that counts as a blow-up

@@ -1,5 +1,6 @@
 #include "solver/dynamics/capsule_flow.h"
 
+#include <algorithm>
 #include <chrono>
 #include <numbers>
 
@@ -60,7 +61,13 @@ FlowEvaluation CapsuleFlow::velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd
 }
 
 double automatic_time_step(const mesh::SurfaceMesh& mesh, double capillary_number, double factor) {
-  return factor * capillary_number * mesh::min_node_spacing(mesh, mesh.nodes);
+  return factor * capillary_number * mesh::min_node_spacing(mesh, mesh.nodes) /
+         (1.0 + kLargeCaCoefficient * capillary_number);
+}
+
+double automatic_time_step(const config::CaseConfig& config, const mesh::SurfaceMesh& mesh) {
+  const double stable = automatic_time_step(mesh, config.capillary_number, config.dt_factor);
+  return config.scheme == "rkc" ? std::max(config.dt_accuracy, stable) : stable;
 }
 
 }  // namespace capsim::dynamics

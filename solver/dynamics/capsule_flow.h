@@ -68,10 +68,32 @@ class CapsuleFlow {
   bool background_flow_ = true;
 };
 
-/// @brief Automatic time step of the explicit schemes: dt = factor · Ca · h_min, h_min the smallest node
-/// spacing on the reference mesh. The membrane's fastest relaxation mode on a mesh of spacing h has rate
-/// ∝ Gs/(μ h), i.e. 1/(Ca h) in units of γ̇, hence the scaling; the factor is measured (see
-/// tests/solver/dynamics) and kept with a safety margin.
+/// @brief Stable time step of the explicit two-stage scheme (rk2):
+///   dt = factor · Ca · h_min / (1 + kLargeCaCoefficient · Ca),
+/// h_min the smallest node spacing on the reference mesh.
+///
+/// Why: the stiff part of dv/dx is the membrane relaxation of the shortest resolved wavelengths, with
+/// nearly real eigenvalues of modulus ρ ≈ C (1 + 0.4 τmax)/(Ca h_min), C = 5.1–6.1 (power iteration, see
+/// membrane_spectral_radius); Heun's real stability interval is 2, so dt ≤ 2/ρ ≈ 0.33–0.39 Ca h_min at small
+/// Ca. At large Ca the prestress τmax (∝ Ca once the capsule is deformed) stiffens these modes: the limit
+/// becomes ∝ h_min alone (a CFL-like bound, but set by tension, not by advection: nodes move with the
+/// material). Measured limit of the factor (RK2, Skalak C = 1, shear flow, 5% initial stretch + 1e-6 h
+/// noise, γ̇t = 3 or 1000 steps; blow-up = collapsed element, NaN, |Δx| > h_min/2, volume change > 5%),
+/// level 2 (level 3 in tests/solver/dynamics/time_stepper_test.cc's comment):
+///
+///   Ca        0.01  0.03  0.1   0.3   1     3
+///   a/b 0.5   0.40  0.38  0.36  0.33  0.23  0.14
+///   a/b 1     0.38  0.38  0.35  0.33  0.26  0.17
+///   a/b 2     0.40  0.40  0.37  0.37  0.27  0.17
+///
+/// fitted from below by 0.38/(1 + 0.75 Ca). The default factor 0.25 (time.dt_factor) keeps a margin of
+/// ≥ 1.4 over every measurement; twice the automatic dt blows up (tested).
 double automatic_time_step(const mesh::SurfaceMesh& mesh, double capillary_number, double factor);
+inline constexpr double kLargeCaCoefficient = 0.75;
+
+/// @brief The automatic dt of a case (time.dt = "auto"): rk2 → the stable dt above with time.dt_factor;
+/// rkc → time.dt_accuracy (accuracy-limited, the stages follow the stiffness), but never less than the rk2
+/// dt (at large Ca the stiffness is mild and the rk2 step is already accurate).
+double automatic_time_step(const config::CaseConfig& config, const mesh::SurfaceMesh& mesh);
 
 }  // namespace capsim::dynamics

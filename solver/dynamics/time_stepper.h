@@ -1,8 +1,18 @@
 #pragma once
 /// @file
-/// @brief Explicit two-stage Runge-Kutta (Heun) on dx/dt = v(x) (DESIGN.md §4):
-///   k1 = v(x_n),  k2 = v(x_n + dt k1),  x_{n+1} = x_n + dt/2 (k1 + k2).
-/// Second order; two flow evaluations per step; stable for dt ≲ c Ca h (automatic_time_step).
+/// @brief Explicit time integrators on dx/dt = v(x) (DESIGN.md §4), selected by `time.scheme`:
+///  - "rk2": Heun, k1 = v(x_n), k2 = v(x_n + dt k1), x_{n+1} = x_n + dt/2 (k1 + k2). Second order, two flow
+///    evaluations per step, stable for dt ρ ≤ 2 on the (nearly real, negative) membrane spectrum, i.e.
+///    dt ≲ 0.33 Ca h_min: see automatic_time_step.
+///  - "rkc": the damped second-order Runge–Kutta–Chebyshev method (van der Houwen & Sommeijer 1980;
+///    Verwer 1996; Sommeijer, Shampine & Verwer 1998, J. Comput. Appl. Math. 88, 315). s stages, s flow
+///    evaluations per step, second order for every s, real stability interval β(s) ≈ 0.653 s² (damping
+///    ε = 2/13). s is chosen per step from the spectral radius ρ(x_n) (membrane_spectral_radius) so that
+///    dt ρ ≤ β(s): the cost per unit time grows like sqrt(ρ/dt) instead of ρ, and dt follows accuracy.
+
+#include <memory>
+#include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -14,17 +24,101 @@ namespace capsim::dynamics {
 struct StepInfo {
   FlowEvaluation start;        ///< evaluation at x_n: τmin(t_n), max speed
   double max_displacement = 0; ///< max |x_{n+1} − x_n| over nodes
+  /// max |Δx_a − Δx_b| over neighbouring nodes a, b of an element (Δx = x_{n+1} − x_n): how much one step
+  /// distorts the mesh. Smooth motion gives ≈ dt |∇v| h ≪ h; an instability gives its own amplitude. Unlike
+  /// max_displacement it does not grow with dt for a capsule advected by the shear, so it is the blow-up
+  /// test that suits both schemes.
+  double max_distortion = 0;
+  int evaluations = 0;         ///< flow evaluations this step used
+  int stages = 0;              ///< Runge–Kutta stages of this step
+};
+
+/// @brief One explicit step of dx/dt = v(x) with a given dt. Integrators keep only work arrays between
+/// steps (no history), so a run resumed from a checkpoint continues exactly.
+class TimeIntegrator {
+ public:
+  virtual ~TimeIntegrator() = default;
+  /// @brief Advance x by dt in place.
+  /// @throws membrane::DegenerateSurface if a stage meets a collapsed surface; x is then unchanged.
+  virtual StepInfo step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt) = 0;
+  [[nodiscard]] virtual std::string name() const = 0;
 };
 
 /// @brief Heun's method with preallocated stage arrays.
-class Rk2Integrator {
+class Rk2Integrator final : public TimeIntegrator {
  public:
-  /// @brief Advance x by dt in place.
-  /// @throws membrane::DegenerateSurface if a stage meets a collapsed surface; x is then unchanged.
-  StepInfo step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt);
+  StepInfo step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt) override;
+  [[nodiscard]] std::string name() const override { return "rk2"; }
 
  private:
   Eigen::Matrix3Xd k1_, k2_, stage_;
 };
+
+/// @brief Coefficients of the s-stage damped second-order RKC (index j = 0..s; entries 0 unused, μ̃ also at 1).
+struct RkcCoefficients {
+  int stages = 0;
+  double w0 = 0, w1 = 0;
+  std::vector<double> mu, nu, mu_tilde, gamma_tilde;
+  /// @brief β(s) = (1 + w0)/w1: the real stability interval is [−β, 0].
+  [[nodiscard]] double stability_boundary() const { return (1.0 + w0) / w1; }
+};
+/// @brief RKC coefficients for s ≥ 2 stages and damping ε (SSV 1998).
+RkcCoefficients rkc_coefficients(int stages, double damping);
+
+/// @brief Damped second-order RKC (SSV 1998, eq. (2.5)–(2.8)):
+///   Y0 = x_n,  Y1 = Y0 + μ̃1 dt F0,
+///   Yj = (1 − μj − νj) Y0 + μj Y_{j−1} + νj Y_{j−2} + μ̃j dt F(Y_{j−1}) + γ̃j dt F0   (j = 2..s),
+///   x_{n+1} = Ys,
+/// with w0 = 1 + ε/s², w1 = T's(w0)/T''s(w0), bj = T''j(w0)/T'j(w0)² (b0 = b1 = b2), aj = 1 − bj Tj(w0),
+/// μ̃1 = b1 w1, μj = 2 bj w0/b_{j−1}, νj = −bj/b_{j−2}, μ̃j = 2 bj w1/b_{j−1}, γ̃j = −a_{j−1} μ̃j.
+/// The stage count is the smallest s ≥ 2 with β(s) ≥ dt · safety · ρ(x_n).
+class RkcIntegrator final : public TimeIntegrator {
+ public:
+  struct Options {
+    double damping = 2.0 / 13.0;  ///< ε of w0 = 1 + ε/s² (SSV's value: β(s) ≈ 0.653 s², strong damping)
+    double safety = 1.25;         ///< ρ used = safety × membrane_spectral_radius (which is itself an upper fit)
+    int max_stages = 400;         ///< refuse (std::runtime_error) beyond: dt far too large for the problem
+  };
+  RkcIntegrator() : RkcIntegrator(Options{}) {}
+  explicit RkcIntegrator(Options options) : options_(options) {}
+  StepInfo step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt) override;
+  [[nodiscard]] std::string name() const override { return "rkc"; }
+
+  /// @brief β(s) = (1 + w0)/w1: the real stability interval [−β, 0] of the s-stage damped RKC.
+  static double stability_boundary(int stages, double damping);
+  /// @brief Smallest s ≥ 2 with stability_boundary(s) ≥ dt_rho.
+  static int stages_for(double dt_rho, double damping);
+  /// @brief The spectral radius the last step used (safety included).
+  [[nodiscard]] double last_spectral_radius() const { return last_rho_; }
+
+ private:
+  Options options_;
+  double last_rho_ = 0.0;
+  Eigen::Matrix3Xd f0_, f_, y_prev_, y_prev2_, y_;
+};
+
+/// @brief max |Δx_a − Δx_b| over the corner–mid-side node pairs of every element.
+double max_element_distortion(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& dx);
+
+/// @brief "rk2" | "rkc" → an integrator. @throws std::invalid_argument naming the accepted values.
+std::unique_ptr<TimeIntegrator> make_integrator(const std::string& scheme);
+
+/// @brief Upper estimate of the spectral radius of ∂v/∂x on positions x, from the membrane relaxation:
+///   ρ ≈ kSpectralRadiusConstant · (1 + kPrestressCoefficient · max(τmax, 0)) / (Ca · h_min(x)),
+/// τmax the largest principal tension (units of Gs) on x, h_min(x) the current node spacing.
+/// Calibrated by power iteration on dv/dx (estimate_spectral_radius): at the reference spheroids
+/// a/b = 0.5, 1, 2 (5% stretch), ρ Ca h_min = 5.1–5.6 at level 2 and 5.8–6.1 at level 3, independent of
+/// Ca; on sheared, prestressed states (level 2, γ̇t = 3) ρ Ca h_min(x) / (1 + 0.4 τmax) = 4.5–5.4 for
+/// Ca = 0.3–1 (τmax = 0.65–3.3): the prestress stiffens the fast modes (geometric stiffness), which is
+/// what lowers the explicit limit at large Ca. The constants bound every measurement from above.
+double membrane_spectral_radius(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x, double capillary_number,
+                                double tau_max);
+inline constexpr double kSpectralRadiusConstant = 6.5;
+inline constexpr double kPrestressCoefficient = 0.4;
+
+/// @brief Power-iteration estimate of the spectral radius of J = ∂v/∂x at x (finite differences of v,
+/// `iterations` flow evaluations plus one). For tests and calibration; the mirror symmetry of a symmetric
+/// scene is kept by symmetrising the iterate, so the estimate is over the modes the run can excite.
+double estimate_spectral_radius(CapsuleFlow& flow, const Eigen::Matrix3Xd& x, int iterations = 60);
 
 }  // namespace capsim::dynamics

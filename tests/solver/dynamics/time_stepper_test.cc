@@ -1,0 +1,192 @@
+#include "solver/dynamics/time_stepper.h"
+
+#include <cmath>
+#include <complex>
+#include <cstdio>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "solver/membrane/membrane_mechanics.h"
+#include "solver/mesh/mesh.h"
+
+namespace capsim::dynamics {
+namespace {
+
+config::CaseConfig make_case(int level, double Ca, double aspect_ratio) {
+  config::CaseConfig c;
+  c.aspect_ratio = aspect_ratio;
+  c.level = level;
+  c.capillary_number = Ca;
+  c.law = "skalak";
+  return c;
+}
+
+// 5% stretch along x1 (volume kept) plus 1e-6 h_min of deterministic noise on every node: excites every mode,
+// including the stiffest, as the stability scans of automatic_time_step did.
+Eigen::Matrix3Xd perturbed_reference(const CapsuleFlow& flow) {
+  Eigen::Matrix3Xd x = flow.reference();
+  x.row(0) *= 1.05;
+  x.row(1) /= std::sqrt(1.05);
+  x.row(2) /= std::sqrt(1.05);
+  const double h = mesh::min_node_spacing(flow.mesh(), flow.reference());
+  std::mt19937 rng(1);
+  std::normal_distribution<double> normal;
+  for (int i = 0; i < x.cols(); ++i)
+    for (int d = 0; d < 3; ++d) x(d, i) += 1e-6 * h * normal(rng);
+  return x;
+}
+
+// The driver's blow-up criteria (case_driver.cc): collapsed element, NaN, a node moving more than h_min/2 in
+// one step (neighbouring nodes relative to each other), volume change beyond 5%. Returns the number of steps done before a blow-up (steps if none).
+int steps_until_blow_up(TimeIntegrator& integrator, CapsuleFlow& flow, Eigen::Matrix3Xd x, double dt, int steps) {
+  const double h = mesh::min_node_spacing(flow.mesh(), flow.reference());
+  const double V0 = membrane::area_and_volume(flow.mesh(), flow.reference()).volume;
+  for (int n = 0; n < steps; ++n) {
+    StepInfo info;
+    try {
+      info = integrator.step(flow, x, dt);
+    } catch (const membrane::DegenerateSurface&) {
+      return n;
+    }
+    const double V = membrane::area_and_volume(flow.mesh(), x).volume;
+    if (!x.allFinite() || info.max_distortion > 0.5 * h || std::abs(V - V0) > 0.05 * V0) return n;
+  }
+  return steps;
+}
+
+// Default factor of the automatic dt (time.dt_factor).
+constexpr double kDefaultFactor = 0.25;
+
+// The automatic dt is stable with a real but not wasteful margin: RK2 in shear flow at the automatic dt
+// survives 200 steps with the stiffest modes excited; at twice that dt it blows up within them.
+TEST(Rk2Stability, AutomaticTimeStepIsStableAndTwiceItIsNot) {
+  EXPECT_EQ(config::CaseConfig{}.dt_factor, kDefaultFactor);
+  for (double Ca : {0.05, 1.0}) {
+    CapsuleFlow flow(make_case(2, Ca, 1.0));
+    const Eigen::Matrix3Xd x0 = perturbed_reference(flow);
+    const double dt = automatic_time_step(flow.mesh(), Ca, kDefaultFactor);
+    Rk2Integrator rk;
+    EXPECT_EQ(steps_until_blow_up(rk, flow, x0, dt, 200), 200) << "Ca = " << Ca;
+    EXPECT_LT(steps_until_blow_up(rk, flow, x0, 2.0 * dt, 200), 200) << "Ca = " << Ca;
+  }
+}
+
+// Stability polynomial of the RKC coefficients, from the stage recurrence applied to y' = z y:
+// second order (R = 1 + z + z²/2 + O(z³)), |R| ≤ 1 on [−β(s), 0], and β(s) ≈ 0.653 s² for ε = 2/13 (SSV 1998).
+std::complex<double> rkc_amplification(const RkcCoefficients& k, std::complex<double> z) {
+  std::complex<double> r2 = 1.0, r1 = 1.0 + k.mu_tilde[1] * z;
+  for (int j = 2; j <= k.stages; ++j) {
+    const std::complex<double> r = (1.0 - k.mu[j] - k.nu[j]) + k.mu[j] * r1 + k.nu[j] * r2 +
+                                   k.mu_tilde[j] * z * r1 + k.gamma_tilde[j] * z;
+    r2 = r1;
+    r1 = r;
+  }
+  return r1;
+}
+
+TEST(Rkc, StabilityPolynomialIsSecondOrderAndBoundedOnItsInterval) {
+  const double eps = 2.0 / 13.0;
+  for (int s : {2, 3, 5, 10, 20, 40}) {
+    const RkcCoefficients k = rkc_coefficients(s, eps);
+    const double beta = k.stability_boundary();
+    EXPECT_NEAR(beta, RkcIntegrator::stability_boundary(s, eps), 1e-12 * beta);
+    EXPECT_NEAR(beta, 2.0 / 3.0 * (s * s - 1) * (1.0 - 2.0 * eps / 15.0), 0.02 * beta) << s;
+    for (double z : {1e-3, -1e-3}) {
+      const double err = std::abs(rkc_amplification(k, z) - (1.0 + z + 0.5 * z * z));
+      EXPECT_LT(err, 2.0 * s * s * s * std::abs(z * z * z)) << "s = " << s;  // O(z³)
+    }
+    double worst = 0.0;
+    for (int i = 0; i <= 2000; ++i) worst = std::max(worst, std::abs(rkc_amplification(k, -beta * i / 2000.0)));
+    EXPECT_LE(worst, 1.0 + 1e-10) << "s = " << s;
+    // Damping: strictly inside the interval |R| stays below 1 − ε-ish away from z = 0.
+    EXPECT_LT(std::abs(rkc_amplification(k, -0.5 * beta)), 0.96) << "s = " << s;
+    // Well beyond β the Chebyshev polynomial takes over: unstable.
+    EXPECT_GT(std::abs(rkc_amplification(k, -1.5 * beta)), 1.0) << "s = " << s;
+    const double b = RkcIntegrator::stability_boundary(s, eps);
+    EXPECT_EQ(RkcIntegrator::stages_for(b, eps), s);
+    EXPECT_EQ(RkcIntegrator::stages_for(b * 1.0001, eps), s + 1);
+  }
+}
+
+// The stiffness estimate that sets the stages bounds the power-iteration spectral radius of dv/dx from above,
+// and not by much (else the stages are wasted).
+TEST(Rkc, MembraneSpectralRadiusBoundsThePowerIteration) {
+  for (double ar : {0.5, 2.0}) {
+    const double Ca = 0.05;
+    CapsuleFlow flow(make_case(2, Ca, ar));
+    const Eigen::Matrix3Xd x = perturbed_reference(flow);
+    Eigen::Matrix3Xd v;
+    const auto ev = flow.velocity(x, v);
+    const double measured = estimate_spectral_radius(flow, x, 40);
+    const double bound = membrane_spectral_radius(flow.mesh(), x, Ca, ev.tau_max);
+    EXPECT_GT(bound, measured) << "a/b = " << ar;
+    EXPECT_LT(bound, 1.5 * measured) << "a/b = " << ar;
+  }
+}
+
+// Relaxation of a stretched capsule in fluid at rest, level 1: the error against a tiny-dt reference falls
+// by ~4 when dt halves (second order), in the stiff regime (dt ρ ≫ 2, several stages per step).
+TEST(Rkc, ConvergesAtSecondOrder) {
+  const double Ca = 0.1;
+  CapsuleFlow flow(make_case(1, Ca, 1.0));
+  flow.set_background_flow(false);
+  Eigen::Matrix3Xd x0 = flow.reference();
+  x0.row(0) *= 1.2;
+  x0.row(1) /= std::sqrt(1.2);
+  x0.row(2) /= std::sqrt(1.2);
+  const double T = 0.4;
+  auto solve = [&](double dt) {
+    RkcIntegrator rkc;
+    Eigen::Matrix3Xd x = x0;
+    const int n = static_cast<int>(std::lround(T / dt));
+    int max_stages = 0;
+    for (int i = 0; i < n; ++i) max_stages = std::max(max_stages, rkc.step(flow, x, dt).stages);
+    return std::pair{x, max_stages};
+  };
+  const Eigen::Matrix3Xd reference = solve(T / 640).first;
+  double previous = 0.0;
+  for (int level = 0; level < 3; ++level) {
+    const double dt = 0.05 / (1 << level);
+    const auto [x, stages] = solve(dt);
+    EXPECT_GE(stages, 4) << "the test must exercise the stabilised regime (dt ρ beyond RK2's interval 2)";
+    const double err = (x - reference).colwise().norm().maxCoeff();
+    std::printf("RKC relaxation: dt %g, up to %d stages, max error %.3g\n", dt, stages, err);
+    if (level > 0) {
+      const double order = std::log2(previous / err);
+      EXPECT_GT(order, 1.7) << "dt = " << dt << " err = " << err << " previous = " << previous;
+      EXPECT_LT(order, 2.5) << "dt = " << dt;
+    }
+    previous = err;
+  }
+}
+
+// Where RK2 blows up, RKC at the same dt is stable (shear flow, stiffest modes excited), and after one
+// shear time its shape agrees with RK2 at its stable dt.
+TEST(Rkc, StableWhereRk2BlowsUpAndAgreesWithIt) {
+  const double Ca = 0.02;
+  CapsuleFlow flow(make_case(1, Ca, 1.0));
+  const Eigen::Matrix3Xd x0 = perturbed_reference(flow);
+  const double dt_rk2 = automatic_time_step(flow.mesh(), Ca, kDefaultFactor);
+  const double dt = 0.02;
+  ASSERT_GT(dt, 4.0 * dt_rk2);
+  Rk2Integrator rk;
+  RkcIntegrator rkc;
+  EXPECT_LT(steps_until_blow_up(rk, flow, x0, dt, 50), 50);
+  EXPECT_EQ(steps_until_blow_up(rkc, flow, x0, dt, 50), 50);
+
+  Eigen::Matrix3Xd a = x0, b = x0;
+  long evaluations_rkc = 0, evaluations_rk2 = 0;
+  for (int i = 0; i < 50; ++i) evaluations_rkc += rkc.step(flow, a, dt).evaluations;
+  const int n = static_cast<int>(std::ceil(1.0 / dt_rk2));
+  for (int i = 0; i < n; ++i) evaluations_rk2 += rk.step(flow, b, 1.0 / n).evaluations;
+  const double extent = flow.reference().colwise().norm().maxCoeff();
+  const double difference = (a - b).colwise().norm().maxCoeff();
+  std::printf("RKC dt %g vs RK2 dt %g after t = 1: max |x_rkc - x_rk2| = %.3g (extent %.3g), evaluations %ld vs %ld\n",
+              dt, 1.0 / n, difference, extent, evaluations_rkc, evaluations_rk2);
+  EXPECT_LT(difference, 5e-4 * extent);
+  EXPECT_LT(3 * evaluations_rkc, evaluations_rk2) << "RKC must need far fewer flow evaluations";
+}
+
+}  // namespace
+}  // namespace capsim::dynamics

@@ -2,7 +2,7 @@
 -- Embedded into the binary at build time (cmake/EmbedSchema.cmake -> capsim::kSchemaSql) and applied once,
 -- in one transaction, when a new database is created, before any worker starts. The version lives in
 -- PRAGMA user_version (and application_id marks the file as a capsim database); a database with another
--- version is refused with a clear error. A future schema change adds 002_*.sql and raises the version.
+-- version is refused with a clear error. Later versions add 00N_*.sql files (see 002_slurm_v2.sql) and raise it.
 -- Only the campaign manager writes this file (WAL journal); queries open it read-only.
 
 PRAGMA application_id = 1129336909;  -- 0x4350534D, "CPSM"

@@ -1,4 +1,4 @@
-// `capsim campaign run|status`: the campaign manager's command line.
+// `capsim campaign run|submit|collect|status`: the campaign manager's command line.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -12,6 +12,7 @@
 #include "campaign/grid/decimal.h"
 #include "campaign/query/table_output.h"
 #include "campaign/scheduler/campaign_runner.h"
+#include "campaign/slurm/slurm.h"
 #include "campaign/store/store.h"
 
 namespace capsim::cli {
@@ -65,6 +66,7 @@ int status(const std::string& db_path, const std::string& name) {
     tr.bind(1, id);
     auto t = campaign::query_table(db, tr);
     if (!t.rows.empty()) std::printf("%s", campaign::render(t, campaign::Format::kMarkdown).c_str());
+    campaign::print_slurm_status(db, id);
   }
   if (shown == 0) {
     if (!name.empty()) throw BadInput(db_path + ": no campaign named '" + name + "'");
@@ -92,6 +94,28 @@ int campaign_command(const std::vector<std::string>& args) {
   run->add_option("--worker", opt.worker, "worker executable (default: $CAPSIM_WORKER, else this capsim)")
       ->group("");  // hidden: for tests and alternative workers
 
+  campaign::SubmitOptions sub;
+  auto* submit = app.add_subcommand(
+      "submit", "register the campaign as `run` does, submit the cases not done yet as a Slurm job array (sbatch)");
+  submit->add_option("campaign", sub.run.campaign_file, "campaign TOML file (see schemas/campaign_keys.md)")->required();
+  submit->add_option("--db", sub.run.db_path, "SQLite results database (created if missing; array tasks never open it)")
+      ->required();
+  submit->add_option("--array-limit", sub.array_limit, "at most K array tasks at once (--array=0-N%K)");
+  submit->add_option("--partition", sub.partition, "Slurm partition");
+  submit->add_option("--time", sub.time_limit, "time limit per array task, HH:MM:SS (SIGTERM 60 s before: checkpoint)");
+  submit->add_option("--cases-per-task", sub.cases_per_task, "cases run one after the other by each array task (default 1)");
+  submit->add_option("--threads-per-job,-t", sub.run.threads_per_job, "threads per case (--cpus-per-task; default 1)");
+  submit->add_flag("--dry-run", sub.run.dry_run, "print the sbatch script that would be submitted, change nothing");
+  submit->add_flag("--retry-failed", sub.run.retry_failed, "submit failed cases again");
+  submit->add_option("--runs-dir", sub.run.runs_dir, "shared folder of the case folders (default: DB.runs)");
+  submit->add_option("--signal-lead", sub.signal_lead_s, "seconds before the time limit Slurm sends SIGTERM (default 60)");
+  submit->add_option("--worker", sub.run.worker, "worker executable (default: $CAPSIM_WORKER, else this capsim)")->group("");
+
+  campaign::CollectOptions col;
+  auto* collect = app.add_subcommand("collect", "ingest the results array tasks left in the case folders (idempotent)");
+  collect->add_option("--db", col.db_path, "SQLite results database")->required();
+  collect->add_option("--campaign", col.campaign, "only this campaign");
+
   std::string status_db, status_name;
   auto* st = app.add_subcommand("status", "counts per status, failures, transitions of each campaign");
   st->add_option("--db", status_db, "SQLite results database")->required();
@@ -112,6 +136,14 @@ int campaign_command(const std::vector<std::string>& args) {
         throw BadInput("--jobs and --threads-per-job must be >= 1");
       return campaign::run_campaign(opt);
     }
+    if (*submit) {
+      if (submit->count("--array-limit") && sub.array_limit < 1) throw BadInput("--array-limit must be >= 1");
+      if (submit->count("--threads-per-job") && sub.run.threads_per_job < 1)
+        throw BadInput("--threads-per-job must be >= 1");
+      if (sub.signal_lead_s < 1) throw BadInput("--signal-lead must be >= 1");
+      return campaign::submit_campaign(sub);
+    }
+    if (*collect) return campaign::collect_campaign(col);
     return status(status_db, status_name);
   } catch (const BadInput& e) {
     std::fprintf(stderr, "capsim campaign: error: %s\n", campaign::one_line(e.what()).c_str());

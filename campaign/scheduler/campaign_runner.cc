@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <set>
 #include <thread>
@@ -23,6 +24,7 @@
 #include "campaign/grid/decimal.h"
 #include "campaign/scheduler/progress.h"
 #include "campaign/scheduler/worker_process.h"
+#include "campaign/slurm/slurm.h"
 #include "campaign/store/store.h"
 
 namespace capsim::campaign {
@@ -63,43 +65,6 @@ class SignalGuard {
  private:
   struct sigaction old_int_ {}, old_term_ {}, old_pipe_ {};
 };
-
-/// One manager per database: an exclusive flock on DB.lock (released by the kernel if we die).
-class ManagerLock {
- public:
-  explicit ManagerLock(const std::string& db_path) : path_(db_path + ".lock") {
-    fd_ = open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd_ < 0) throw BadInput(path_ + ": cannot create lock file: " + std::strerror(errno));
-    if (flock(fd_, LOCK_EX | LOCK_NB) != 0) {
-      char buf[64] = {0};
-      (void)!pread(fd_, buf, sizeof buf - 1, 0);
-      close(fd_);
-      fd_ = -1;
-      throw BadInput(db_path + ": another campaign manager is running on this database (pid " +
-                     std::string(buf[0] ? buf : "?") + ")");
-    }
-    std::string pid = std::to_string(getpid());
-    (void)!ftruncate(fd_, 0);
-    (void)!pwrite(fd_, pid.data(), pid.size(), 0);
-  }
-  ~ManagerLock() {
-    if (fd_ >= 0) close(fd_);
-  }
-
- private:
-  std::string path_;
-  int fd_ = -1;
-};
-
-void write_file_atomic(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out << text;
-    if (!out) throw std::runtime_error(tmp + ": cannot write");
-  }
-  fs::rename(tmp, path);
-}
 
 struct Running {
   CaseRow row;
@@ -194,10 +159,8 @@ class Runner {
   }
 
   void start(CaseRow row) {
-    if (row.out_dir.empty()) row.out_dir = runs_dir_ + "/" + row.case_id;
-    fs::create_directories(row.out_dir);
+    row.out_dir = prepare_case_folder(row, runs_dir_);
     const std::string toml = row.out_dir + "/case.toml";
-    write_file_atomic(toml, row.params.to_toml());
     const bool resume = row.resumable;
     WorkerCommand cmd;
     cmd.executable = worker_;
@@ -265,10 +228,14 @@ class Runner {
 };
 
 /// After a manager crash: stop leftover workers, then ingest finished results or requeue.
-void recover(Store& store, const std::string& runs_dir, Runner* log) {
-  auto orphans = find_orphan_workers(runs_dir);
+void recover(Store& store, const std::string& runs_dir, const std::function<void(const std::string&)>& log) {
+  // Only workers of cases this database has `running` (a local manager's) are orphans; a worker of a
+  // Slurm array task on this host (its case is queued here) is left alone.
+  std::set<std::string> running_dirs;
+  for (const auto& row : store.running_cases()) running_dirs.insert(row.out_dir);
+  auto orphans = running_dirs.empty() ? std::vector<pid_t>{} : find_orphan_workers(runs_dir, running_dirs);
   if (!orphans.empty()) {
-    if (log) log->message("capsim campaign: stopping " + std::to_string(orphans.size()) +
+    log("capsim campaign: stopping " + std::to_string(orphans.size()) +
                           " worker(s) left by an earlier manager");
     stop_processes(orphans, 60);
   }
@@ -276,13 +243,14 @@ void recover(Store& store, const std::string& runs_dir, Runner* log) {
     const std::string line = last_line_of(row.out_dir + "/stdout.log");
     const std::string h5 = fs::exists(row.out_dir + "/case.h5") ? row.out_dir + "/case.h5" : "";
     const std::string status = store.recover_orphan(row.case_id, line, has_checkpoint(row.out_dir), h5, row.params);
-    if (log) log->message("capsim campaign: case " + row.case_id + " was running when the manager stopped: " +
+    log("capsim campaign: case " + row.case_id + " was running when the manager stopped: " +
                           (status == "queued" ? "requeued" : "result ingested (" + status + ")"));
   }
 }
 
-/// Adds adaptive cases; returns how many were added.
-int refine(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir) {
+}  // namespace
+
+int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir) {
   int adaptive_so_far = static_cast<int>(std::get<std::int64_t>(
       *store.db().scalar("SELECT count(*) FROM campaign_cases WHERE origin='adaptive' AND campaign_id=" +
                          std::to_string(campaign_id))));
@@ -312,6 +280,8 @@ int refine(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, con
   (void)n;
   return static_cast<int>(add.size());
 }
+
+namespace {
 
 int dry_run(const RunOptions& opt, const CampaignSpec& spec, const std::vector<CaseParams>& cases) {
   std::unique_ptr<Store> store;
@@ -350,6 +320,65 @@ int dry_run(const RunOptions& opt, const CampaignSpec& spec, const std::vector<C
 
 std::string default_runs_dir(const std::string& db_path) { return db_path + ".runs"; }
 
+ManagerLock::ManagerLock(const std::string& db_path) : path_(db_path + ".lock") {
+  fd_ = open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw BadInput(path_ + ": cannot create lock file: " + std::strerror(errno));
+  if (flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    char buf[64] = {0};
+    (void)!pread(fd_, buf, sizeof buf - 1, 0);
+    close(fd_);
+    fd_ = -1;
+    throw BadInput(db_path + ": another campaign manager is running on this database (pid " +
+                   std::string(buf[0] ? buf : "?") + ")");
+  }
+  std::string pid = std::to_string(getpid());
+  (void)!ftruncate(fd_, 0);
+  (void)!pwrite(fd_, pid.data(), pid.size(), 0);
+}
+
+ManagerLock::~ManagerLock() {
+  if (fd_ >= 0) close(fd_);
+}
+
+void write_file_atomic(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << text;
+    if (!out) throw std::runtime_error(tmp + ": cannot write");
+  }
+  fs::rename(tmp, path);
+}
+
+std::string prepare_case_folder(const CaseRow& row, const std::string& runs_dir) {
+  const std::string dir = row.out_dir.empty() ? runs_dir + "/" + row.case_id : row.out_dir;
+  fs::create_directories(dir);
+  write_file_atomic(dir + "/case.toml", row.params.to_toml());
+  return dir;
+}
+
+PreparedCampaign prepare_campaign(const RunOptions& opt, const std::function<void(const std::string&)>& log) {
+  PreparedCampaign pc;
+  pc.spec = load_campaign_file(opt.campaign_file);
+  pc.cases = expand_grid(pc.spec);
+  const fs::path db_dir = fs::absolute(opt.db_path).parent_path();
+  if (!fs::is_directory(db_dir)) throw BadInput(opt.db_path + ": folder " + db_dir.string() + " does not exist");
+  pc.lock = std::make_unique<ManagerLock>(opt.db_path);
+  pc.store = Store::open_for_write(opt.db_path);
+  pc.runs_dir =
+      fs::weakly_canonical(fs::absolute(opt.runs_dir.empty() ? default_runs_dir(opt.db_path) : opt.runs_dir)).string();
+  fs::create_directories(pc.runs_dir);
+  {
+    Transaction t(pc.store->db());
+    pc.campaign_id = pc.store->upsert_campaign(pc.spec);
+    pc.store->add_cases(pc.campaign_id, pc.cases, "grid", pc.runs_dir);
+    if (opt.retry_failed) pc.store->requeue_failed(pc.campaign_id);
+    t.commit();
+  }
+  recover(*pc.store, pc.runs_dir, log);
+  return pc;
+}
+
 int run_campaign(const RunOptions& opt) {
   const CampaignSpec spec = load_campaign_file(opt.campaign_file);
   const std::vector<CaseParams> cases = expand_grid(spec);
@@ -364,25 +393,20 @@ int run_campaign(const RunOptions& opt) {
   if (jobs == 0) jobs = std::max(1, cores / threads);
   if (threads == 0) threads = std::max(1, cores / jobs);
 
-  const fs::path db_dir = fs::absolute(opt.db_path).parent_path();
-  if (!fs::is_directory(db_dir)) throw BadInput(opt.db_path + ": folder " + db_dir.string() + " does not exist");
-  ManagerLock lock(opt.db_path);
-  auto store = Store::open_for_write(opt.db_path);
-  const std::string runs_dir =
-      fs::weakly_canonical(fs::absolute(opt.runs_dir.empty() ? default_runs_dir(opt.db_path) : opt.runs_dir)).string();
-  fs::create_directories(runs_dir);
-
+  Runner* runner_ptr = nullptr;
+  std::vector<std::string> early;  // messages before the progress display exists
+  PreparedCampaign pc = prepare_campaign(opt, [&](const std::string& m) {
+    if (runner_ptr) runner_ptr->message(m);
+    else early.push_back(m);
+  });
+  check_no_live_slurm_tasks(*pc.store, pc.campaign_id);
   SignalGuard signals;
-  std::int64_t campaign_id;
-  {
-    Transaction t(store->db());
-    campaign_id = store->upsert_campaign(spec);
-    store->add_cases(campaign_id, cases, "grid", runs_dir);
-    if (opt.retry_failed) store->requeue_failed(campaign_id);
-    t.commit();
-  }
+  auto& store = pc.store;
+  const std::int64_t campaign_id = pc.campaign_id;
+  const std::string& runs_dir = pc.runs_dir;
   Runner runner(opt, *store, campaign_id, spec.name, jobs, threads, runs_dir);
-  recover(*store, runs_dir, &runner);
+  runner_ptr = &runner;
+  for (const auto& m : early) runner.message(m);
   runner.message("capsim campaign: '" + spec.name + "': " + std::to_string(cases.size()) + " grid cases, " +
                  std::to_string(jobs) + " job(s) x " + std::to_string(threads) + " thread(s), database " + opt.db_path);
 
@@ -390,7 +414,7 @@ int run_campaign(const RunOptions& opt) {
   const std::string method = spec.analysis.adaptive ? "adaptive" : "grid";
   if (completed && spec.analysis.adaptive) {
     for (int round = 1; round <= spec.analysis.max_rounds && completed; ++round) {
-      int added = refine(*store, campaign_id, spec, runs_dir);
+      int added = refine_campaign(*store, campaign_id, spec, runs_dir);
       if (added == 0) break;
       runner.message("capsim campaign: adaptive round " + std::to_string(round) + ": " + std::to_string(added) +
                      " case(s) added");

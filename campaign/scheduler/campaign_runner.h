@@ -3,7 +3,14 @@
 /// @brief `capsim campaign run`: expands a campaign, recovers from an earlier crash, runs the pending cases
 /// as J worker processes, records outcomes, stops cleanly on SIGINT/SIGTERM, and recomputes transitions.
 
+#include <cstdint>
+#include <functional>
+#include <memory>
 #include <string>
+#include <vector>
+
+#include "campaign/grid/campaign_spec.h"
+#include "campaign/store/store.h"
 
 namespace capsim::campaign {
 
@@ -34,5 +41,48 @@ int run_campaign(const RunOptions& opt);
 
 /// @brief The default runs folder of a database: DB + ".runs".
 std::string default_runs_dir(const std::string& db_path);
+
+/// @brief One writer per database: an exclusive flock on DB.lock (released by the kernel if the holder
+/// dies). Every command that writes the database (run, submit, collect) holds it. @throws BadInput if
+/// another process holds it.
+class ManagerLock {
+ public:
+  explicit ManagerLock(const std::string& db_path);
+  ~ManagerLock();
+  ManagerLock(const ManagerLock&) = delete;
+  ManagerLock& operator=(const ManagerLock&) = delete;
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+};
+
+/// @brief A campaign registered in its database, ready to run (by local workers or a Slurm array).
+struct PreparedCampaign {
+  CampaignSpec spec;                  ///< the validated file
+  std::vector<CaseParams> cases;      ///< expanded grid
+  std::unique_ptr<ManagerLock> lock;  ///< held while the database is open for writing
+  std::unique_ptr<Store> store;       ///< opened for writing (created/migrated if needed)
+  std::int64_t campaign_id = 0;       ///< its row
+  std::string runs_dir;               ///< absolute folder of the case folders
+};
+
+/// @brief The common start of `campaign run` and `campaign submit`: validates the file, takes the
+/// database lock, opens/creates the store, registers the campaign and its grid cases (queued), requeues
+/// failed ones with opt.retry_failed, and recovers cases a crashed manager left running (orphan workers
+/// stopped; a finished result ingested, else requeued). @p log receives one-line messages.
+/// @throws BadInput (nothing changed).
+PreparedCampaign prepare_campaign(const RunOptions& opt, const std::function<void(const std::string&)>& log);
+
+/// @brief Creates the folder of a case (row.out_dir, or runs_dir/case_id) and writes its case.toml
+/// atomically; returns the folder.
+std::string prepare_case_folder(const CaseRow& row, const std::string& runs_dir);
+
+/// @brief Adds adaptive cases to bracket the transitions of a campaign (adaptive mode, one round);
+/// returns how many were added.
+int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir);
+
+/// @brief Writes @p text to @p path via a temporary file in the same folder and rename (atomic).
+void write_file_atomic(const std::string& path, const std::string& text);
 
 }  // namespace capsim::campaign

@@ -74,7 +74,7 @@ pid_t spawn_worker(const WorkerCommand& cmd) {
   return pid;
 }
 
-std::vector<pid_t> find_orphan_workers(const std::string& runs_dir) {
+std::vector<pid_t> find_orphan_workers(const std::string& runs_dir, const std::set<std::string>& only_dirs) {
   std::vector<pid_t> out;
   const std::string prefix = fs::weakly_canonical(runs_dir).string() + "/";
   std::error_code ec;
@@ -97,7 +97,10 @@ std::vector<pid_t> find_orphan_workers(const std::string& runs_dir) {
     }
     bool match = false;
     for (std::size_t i = 0; i + 1 < args.size(); ++i)
-      if (args[i] == "--out" && args[i + 1].rfind(prefix, 0) == 0) match = true;
+      if (args[i] == "--out" && args[i + 1].rfind(prefix, 0) == 0 &&
+          (only_dirs.empty() || only_dirs.count(args[i + 1]) ||
+           only_dirs.count(fs::weakly_canonical(args[i + 1], ec).string())))
+        match = true;
     if (!match) continue;
     std::ifstream sf(e.path() / "stat");
     std::string stat_line;

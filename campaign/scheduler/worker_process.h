@@ -4,6 +4,7 @@
 
 #include <sys/types.h>
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -29,8 +30,9 @@ std::vector<std::string> worker_args(const std::string& case_toml, const std::st
 pid_t spawn_worker(const WorkerCommand& cmd);
 
 /// @brief Pids of live processes whose command line has `--out DIR` with DIR inside @p runs_dir (workers
-/// left behind by a manager that died), excluding zombies.
-std::vector<pid_t> find_orphan_workers(const std::string& runs_dir);
+/// left behind by a manager that died), excluding zombies. With @p only_dirs non-empty, only workers whose
+/// `--out` is one of these folders.
+std::vector<pid_t> find_orphan_workers(const std::string& runs_dir, const std::set<std::string>& only_dirs = {});
 
 /// @brief Sends SIGTERM to @p pids (they checkpoint), waits up to @p grace_s for them to end, then SIGKILL.
 void stop_processes(const std::vector<pid_t>& pids, double grace_s);

@@ -26,8 +26,9 @@ std::int64_t as_int(const std::optional<SqlValue>& v) {
   return 0;
 }
 
-/// Reads the header pragmas; a non-database file fails here, before anything is written.
-void verify_header(Db& db, bool& fresh) {
+/// Reads the header pragmas; a non-database file fails here, before anything is written. Sets @p version
+/// to the file's schema version (0 for a fresh file).
+void verify_header(Db& db, bool& fresh, std::int64_t& file_version) {
   std::int64_t app = 0, version = 0, tables = 0;
   try {
     app = as_int(db.scalar("PRAGMA application_id"));
@@ -37,14 +38,15 @@ void verify_header(Db& db, bool& fresh) {
     throw BadInput(db.path() + ": not a capsim database or corrupt (" + e.what() + ")");
   }
   fresh = (app == 0 && version == 0 && tables == 0);
+  file_version = version;
   if (fresh) return;
   if (app != kApplicationId)
     throw BadInput(db.path() + ": not a capsim campaign database (application_id " + std::to_string(app) + ")");
   const int want = Store::expected_schema_version();
-  if (version != want)
+  if (version < Store::kOldestMigratableVersion || version > want)
     throw BadInput(db.path() + ": database schema version " + std::to_string(version) + ", this capsim (" +
-                   std::string(kGitCommit) + ") reads version " + std::to_string(want) +
-                   "; use a matching capsim or a new --db file");
+                   std::string(kGitCommit) + ") reads versions " + std::to_string(Store::kOldestMigratableVersion) +
+                   ".." + std::to_string(want) + "; use a matching capsim or a new --db file");
   std::string check;
   try {
     check = std::get<std::string>(db.scalar("PRAGMA quick_check").value_or(SqlValue{std::string("?")}));
@@ -53,6 +55,8 @@ void verify_header(Db& db, bool& fresh) {
   }
   if (check != "ok") throw BadInput(db.path() + ": database is corrupt (quick_check: " + check + ")");
 }
+
+}  // namespace
 
 std::optional<nlohmann::json> parse_result_line(const std::string& line) {
   try {
@@ -66,6 +70,7 @@ std::optional<nlohmann::json> parse_result_line(const std::string& line) {
   }
 }
 
+namespace {
 SqlValue jnum(const nlohmann::json& j, const char* k) {
   if (!j.contains(k) || !j[k].is_number()) return nullptr;
   if (j[k].is_number_integer()) return j[k].get<std::int64_t>();
@@ -77,9 +82,9 @@ SqlValue jstr(const nlohmann::json& j, const char* k) {
   if (!j.contains(k) || !j[k].is_string()) return nullptr;
   return j[k].get<std::string>();
 }
+}  // namespace
 
-/// Returns "" if the worker's reported parameters match the case, else what differs.
-std::string mismatch(const nlohmann::json& j, const CaseParams& p) {
+std::string result_mismatch(const nlohmann::json& j, const CaseParams& p) {
   auto near = [](double a, double b) { return std::fabs(a - b) <= 1e-9 * std::max(1.0, std::fabs(b)); };
   for (const char* k : {"capillary_number", "Ca"})
     if (j.contains(k) && j[k].is_number() && !near(j[k].get<double>(), p.capillary_number()))
@@ -105,13 +110,17 @@ void insert_result(Db& db, const std::string& case_id, const nlohmann::json& j, 
   s.step();
 }
 
-std::string reason_of(const nlohmann::json& j) {
+std::string result_reason(const nlohmann::json& j) {
   for (const char* k : {"reason", "error", "message"})
     if (j.contains(k) && j[k].is_string()) return j[k].get<std::string>();
   return "blow-up reported by the solver";
 }
 
-}  // namespace
+bool has_table(Db& db, const std::string& name) {
+  Stmt s(db, "SELECT 1 FROM sqlite_master WHERE type='table' AND name=?");
+  s.bind(1, name);
+  return s.step();
+}
 
 std::string host_name() {
   char buf[256] = {0};
@@ -141,7 +150,8 @@ std::unique_ptr<Store> Store::open_for_write(const std::string& path) {
     throw BadInput(e.what());
   }
   bool fresh = false;
-  verify_header(*db, fresh);
+  std::int64_t version = 0;
+  verify_header(*db, fresh, version);
   try {
     db->exec("PRAGMA journal_mode=WAL");
     db->exec("PRAGMA synchronous=NORMAL");
@@ -153,6 +163,19 @@ std::unique_ptr<Store> Store::open_for_write(const std::string& path) {
                       "),('created_by',?),('schema_version',?)");
       s.bind(1, std::string(kGitCommit)).bind(2, std::to_string(expected_schema_version()));
       s.step();
+      t.commit();
+    } else if (version < expected_schema_version()) {
+      // Migration: the embedded DDL is additive and idempotent (CREATE ... IF NOT EXISTS) from version
+      // kOldestMigratableVersion on, so applying all of it adds what is missing and raises user_version.
+      Transaction t(*db);
+      db->exec(kSchemaSql);
+      Stmt s(*db, std::string("INSERT OR REPLACE INTO meta(key,value) VALUES('migrated_at',") + kNow +
+                      "),('migrated_from',?),('migrated_by',?),('schema_version',?)");
+      s.bind(1, std::to_string(version)).bind(2, std::string(kGitCommit));
+      s.bind(3, std::to_string(expected_schema_version()));
+      s.step();
+      if (as_int(db->scalar("PRAGMA user_version")) != expected_schema_version())
+        throw BadInput(path + ": migration from schema version " + std::to_string(version) + " failed");
       t.commit();
     }
   } catch (const DbError& e) {
@@ -170,7 +193,8 @@ std::unique_ptr<Store> Store::open_readonly(const std::string& path) {
     throw BadInput(e.what());
   }
   bool fresh = false;
-  verify_header(*db, fresh);
+  std::int64_t version = 0;
+  verify_header(*db, fresh, version);
   if (fresh) throw BadInput(path + ": empty database (no campaign has been run into it)");
   db->exec("PRAGMA query_only=ON");
   return std::unique_ptr<Store>(new Store(std::move(db)));
@@ -286,20 +310,20 @@ std::string Store::record_outcome(const std::string& case_id, std::int64_t attem
     if (!j) {
       status = outcome = "failed";
       error = "worker exited 0 without a JSON result line (status done|unstable) on stdout; stderr: " + out.stderr_tail;
-    } else if (auto m = mismatch(*j, params); !m.empty()) {
+    } else if (auto m = result_mismatch(*j, params); !m.empty()) {
       status = outcome = "failed";
       error = "worker reported parameters that differ from the case: " + m;
       j.reset();
     } else {
       status = outcome = (*j)["status"].get<std::string>();
-      if (status == "unstable") error = reason_of(*j);
+      if (status == "unstable") error = result_reason(*j);
     }
   } else if (out.signal == 0 && out.exit_code == 3 && parse_result_line(out.last_line) &&
-             mismatch(*parse_result_line(out.last_line), params).empty()) {
+             result_mismatch(*parse_result_line(out.last_line), params).empty()) {
     // Interrupted after the result was printed: the result stands.
     j = parse_result_line(out.last_line);
     status = outcome = (*j)["status"].get<std::string>();
-    if (status == "unstable") error = reason_of(*j);
+    if (status == "unstable") error = result_reason(*j);
   } else if (out.signal == 0 && out.exit_code == 3) {
     status = "queued";
     outcome = "interrupted";
@@ -333,7 +357,7 @@ std::string Store::record_outcome(const std::string& case_id, std::int64_t attem
 std::string Store::recover_orphan(const std::string& case_id, const std::string& result_line, bool resumable,
                                   const std::string& h5_path, const CaseParams& params) {
   auto j = parse_result_line(result_line);
-  if (j && !mismatch(*j, params).empty()) j.reset();
+  if (j && !result_mismatch(*j, params).empty()) j.reset();
   Transaction t(*db_);
   std::string status;
   if (j) {
@@ -342,7 +366,7 @@ std::string Store::recover_orphan(const std::string& case_id, const std::string&
     Stmt u(*db_, std::string("UPDATE cases SET status=?, resumable=0, finished_at=") + kNow +
                      ", exit_code=0, code_version=coalesce(?,code_version), error=?, h5_path=? WHERE case_id=?");
     u.bind(1, status).bind(2, jstr(*j, "code_version"));
-    u.bind(3, status == "unstable" ? SqlValue{reason_of(*j)} : SqlValue{nullptr});
+    u.bind(3, status == "unstable" ? SqlValue{result_reason(*j)} : SqlValue{nullptr});
     u.bind(4, h5_path.empty() ? SqlValue{nullptr} : SqlValue{h5_path}).bind(5, case_id);
     u.step();
   } else {

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -60,12 +61,18 @@ struct Transition {
 class Store {
  public:
   /// @brief Opens for writing, creating the file and schema if needed (one transaction, before any
-  /// worker). @throws BadInput for a corrupt/foreign file or another schema version (nothing written).
+  /// worker). A database of an older schema version this build can migrate (1 -> 2: adds the Slurm
+  /// tables) is migrated in one transaction; a newer or unknown version is refused.
+  /// @throws BadInput for a corrupt/foreign file or a version it cannot read (nothing written).
   static std::unique_ptr<Store> open_for_write(const std::string& path);
-  /// @brief Opens an existing database read-only (queries, status, dry runs). @throws BadInput.
+  /// @brief Opens an existing database read-only (queries, status, dry runs). An older version that
+  /// is a subset of the current one (1) is read as is. @throws BadInput.
   static std::unique_ptr<Store> open_readonly(const std::string& path);
   /// @brief The schema version this build creates (parsed from the embedded DDL).
   static int expected_schema_version();
+  /// @brief The oldest schema version this build reads and migrates (the embedded DDL is additive and
+  /// idempotent from this version on: CREATE ... IF NOT EXISTS only).
+  static constexpr int kOldestMigratableVersion = 1;
 
   /// @brief The connection.
   Db& db() { return *db_; }
@@ -106,5 +113,22 @@ class Store {
 
 /// @brief This machine's host name.
 std::string host_name();
+
+/// @brief The worker's JSON result line parsed, if it is a complete result (an object with status
+/// "done" or "unstable"); nullopt for anything else (empty, truncated, corrupt, another status).
+std::optional<nlohmann::json> parse_result_line(const std::string& line);
+
+/// @brief "" if the parameters a worker reported in its result match the case, else what differs.
+std::string result_mismatch(const nlohmann::json& result, const CaseParams& params);
+
+/// @brief Inserts (or replaces) the results row of a case from its parsed result line @p j and the raw
+/// @p line. The caller holds a transaction.
+void insert_result(Db& db, const std::string& case_id, const nlohmann::json& j, const std::string& line);
+
+/// @brief The reason an unstable result gives (or a generic one).
+std::string result_reason(const nlohmann::json& j);
+
+/// @brief Whether table @p name exists (a database of schema version 1 has no Slurm tables).
+bool has_table(Db& db, const std::string& name);
 
 }  // namespace capsim::campaign

@@ -17,7 +17,6 @@ struct LoadSolver::Impl {
   std::vector<std::array<double, 6>> N;                      // per rule point
   std::vector<std::array<std::array<double, 6>, 2>> dN;      // per rule point
   std::vector<double> w;                                     // rule weights · ½
-  Eigen::Matrix3Xd previous_q;                               // CG warm start
 };
 
 LoadSolver::LoadSolver(const mesh::SurfaceMesh& mesh, Options options)
@@ -100,16 +99,13 @@ void LoadSolver::solve(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
     q = impl_->cholmod.solve(rhs).transpose();
     last_iterations_ = 0;
   } else {
-    if (impl_->previous_q.cols() != R.cols()) impl_->previous_q = Eigen::Matrix3Xd::Zero(3, R.cols());
-    Eigen::MatrixX3d guess = impl_->previous_q.transpose();
     Eigen::MatrixX3d sol(R.cols(), 3);
     last_iterations_ = 0;
     for (int c = 0; c < 3; ++c) {
-      sol.col(c) = impl_->cg.solveWithGuess(rhs.col(c), guess.col(c));
+      sol.col(c) = impl_->cg.solve(rhs.col(c));
       last_iterations_ += static_cast<int>(impl_->cg.iterations());
     }
     q = sol.transpose();
-    impl_->previous_q = q;
   }
 }
 

@@ -139,7 +139,8 @@ CaseResult run_case(const config::CaseConfig& config, const RunOptions& options)
       r.reason = "stop requested at t = " + std::to_string(t) + "; resume continues from the checkpoint";
       break;
     }
-    if (t >= config.t_end - eps) {
+    // Never step past the hard cap: the last step ends within one dt before t_end.
+    if (t + dt > config.t_end + eps) {
       r.status = "done";
       break;
     }

@@ -194,6 +194,12 @@ std::string CaseConfig::to_toml() const {
   return out;
 }
 
+std::vector<std::string> case_key_names() {
+  std::vector<std::string> out;
+  for (const auto& s : key_specs()) out.push_back(std::string(s.section) + "." + s.name);
+  return out;
+}
+
 CaseConfig parse_case_config(const std::string& text, const std::string& origin,
                              const std::vector<std::string>& overrides) {
   CaseConfig c;

@@ -54,6 +54,10 @@ struct CaseConfig {
   [[nodiscard]] std::map<std::string, std::string> to_map() const;
 };
 
+/// @brief Every accepted case key as "section.key", in file order (the campaign layer checks its own key
+/// table against this list, so the two can never drift apart).
+std::vector<std::string> case_key_names();
+
 /// @brief Read a case file (may be empty: all defaults) and apply `section.key=value` overrides.
 /// @throws ConfigError for a missing/unreadable/unparsable file, an unknown key, a wrong type or a value
 /// out of range; the message names the key or file.

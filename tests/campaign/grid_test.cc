@@ -7,6 +7,8 @@
 #include "campaign/grid/campaign_spec.h"
 #include "campaign/grid/decimal.h"
 #include "campaign/grid/sha256.h"
+#include "campaign/grid/case_keys.h"
+#include "solver/config/case_config.h"
 
 namespace capsim::campaign {
 namespace {
@@ -182,5 +184,18 @@ TEST(Grid, CaseTomlHasSections) {
   EXPECT_NE(t.find("[mesh]\nlevel = 3\n"), std::string::npos) << t;
 }
 
+}  // namespace
+}  // namespace capsim::campaign
+
+namespace capsim::campaign {
+namespace {
+// The campaign's key table mirrors the solver's: a key added to one and not the other would make campaigns
+// reject valid case keys or pass unknown ones to the solver.
+TEST(CaseKeys, SameSetAsTheSolver) {
+  std::set<std::string> campaign_side, solver_side;
+  for (const auto& k : case_keys()) campaign_side.insert(k.name);
+  for (const auto& k : config::case_key_names()) solver_side.insert(k);
+  EXPECT_EQ(campaign_side, solver_side);
+}
 }  // namespace
 }  // namespace capsim::campaign

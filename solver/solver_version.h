@@ -8,5 +8,5 @@
 
 namespace capsim {
 /// @brief Numerical-results version of the solver.
-inline constexpr const char* kSolverVersion = "1";
+inline constexpr const char* kSolverVersion = "2";  // 2: volume correction on by default
 }  // namespace capsim

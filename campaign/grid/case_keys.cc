@@ -26,6 +26,7 @@ const std::vector<CaseKey>& case_keys() {
       {"numerics.regular_degree", KeyType::kInt, std::nullopt, true, "boundary-integral triangle rule: 4, 5, 6"},
       {"numerics.duffy_order", KeyType::kInt, std::nullopt, true, "Gauss points per direction, singular integrals"},
       {"numerics.membrane_degree", KeyType::kInt, std::nullopt, true, "membrane/mass-matrix triangle rule: 4, 5, 6"},
+      {"numerics.volume_correction", KeyType::kBool, std::nullopt, true, "remove the discrete volume flux (true/false)"},
       {"output.snapshot_interval", KeyType::kFloat, Value{0.0}, false, "time between snapshots, 0 = none"},
       {"output.checkpoint_interval", KeyType::kFloat, std::nullopt, false, "time between checkpoints"},
       {"output.sample_interval", KeyType::kFloat, std::nullopt, true, "time-series sampling (0 = every step)"},

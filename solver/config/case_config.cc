@@ -38,6 +38,10 @@ int as_int(const toml::node& n, const std::string& where) {
   if (auto v = n.value_exact<int64_t>()) return static_cast<int>(*v);
   throw ConfigError(where + ": expected an integer");
 }
+bool as_bool(const toml::node& n, const std::string& where) {
+  if (auto v = n.value_exact<bool>()) return *v;
+  throw ConfigError(where + ": expected true or false");
+}
 std::string as_string(const toml::node& n, const std::string& where) {
   if (auto v = n.value_exact<std::string>()) return *v;
   throw ConfigError(where + ": expected a string");
@@ -70,6 +74,7 @@ const std::vector<KeySpec>& key_specs() {
       {"numerics", "regular_degree", [](auto& n, auto& c, auto& w) { c.regular_degree = as_int(n, w); }},
       {"numerics", "duffy_order", [](auto& n, auto& c, auto& w) { c.duffy_order = as_int(n, w); }},
       {"numerics", "membrane_degree", [](auto& n, auto& c, auto& w) { c.membrane_degree = as_int(n, w); }},
+      {"numerics", "volume_correction", [](auto& n, auto& c, auto& w) { c.volume_correction = as_bool(n, w); }},
       {"output", "snapshot_interval", [](auto& n, auto& c, auto& w) { c.snapshot_interval = as_number(n, w); }},
       {"output", "checkpoint_interval", [](auto& n, auto& c, auto& w) { c.checkpoint_interval = as_number(n, w); }},
       {"output", "sample_interval", [](auto& n, auto& c, auto& w) { c.sample_interval = as_number(n, w); }},
@@ -176,6 +181,7 @@ std::map<std::string, std::string> CaseConfig::to_map() const {
       {"numerics.regular_degree", std::to_string(regular_degree)},
       {"numerics.duffy_order", std::to_string(duffy_order)},
       {"numerics.membrane_degree", std::to_string(membrane_degree)},
+      {"numerics.volume_correction", volume_correction ? "true" : "false"},
       {"output.snapshot_interval", fmt_double(snapshot_interval)},
       {"output.checkpoint_interval", fmt_double(checkpoint_interval)},
       {"output.sample_interval", fmt_double(sample_interval)},

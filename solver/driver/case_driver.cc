@@ -12,7 +12,6 @@
 #include "solver/io/case_file.h"
 #include "solver/io/checkpoint.h"
 #include "solver/membrane/membrane_mechanics.h"
-#include "solver/mesh/p2_element.h"
 
 namespace capsim::driver {
 namespace {
@@ -34,29 +33,11 @@ std::vector<io::Attribute> case_attributes(const config::CaseConfig& c) {
   return a;
 }
 
-// Outward unit normals at the nodes: average of the exact P2 normals of the elements around each node.
-Eigen::Matrix3Xd node_normals(const mesh::SurfaceMesh& m, const Eigen::Matrix3Xd& x) {
-  static constexpr double local[6][2] = {{0, 0}, {1, 0}, {0, 1}, {0.5, 0}, {0.5, 0.5}, {0, 0.5}};
-  Eigen::Matrix3Xd n = Eigen::Matrix3Xd::Zero(3, x.cols());
-  for (const auto& el : m.elements)
-    for (int k = 0; k < 6; ++k) {
-      const auto dN = mesh::p2_shape_gradients(local[k][0], local[k][1]);
-      Eigen::Vector3d g1 = Eigen::Vector3d::Zero(), g2 = Eigen::Vector3d::Zero();
-      for (int a = 0; a < 6; ++a) {
-        g1 += dN[0][a] * x.col(el[a]);
-        g2 += dN[1][a] * x.col(el[a]);
-      }
-      n.col(el[k]) += g1.cross(g2).normalized();
-    }
-  n.colwise().normalize();
-  return n;
-}
-
 void write_snapshot(io::CaseWriter& writer, dynamics::CapsuleFlow& flow, const Eigen::Matrix3Xd& x, double t,
                     long step) {
   Eigen::Matrix3Xd v, q;
   flow.velocity(x, v, &q);
-  const Eigen::Matrix3Xd n = node_normals(flow.mesh(), x);
+  const Eigen::Matrix3Xd n = mesh::node_normals(flow.mesh(), x);
   const Eigen::VectorXd qn = (q.array() * n.array()).colwise().sum().transpose();
   const io::NodeField fields[] = {io::NodeField::scalar("q_n", qn), io::NodeField::vector("q", q),
                                   io::NodeField::vector("velocity", v)};

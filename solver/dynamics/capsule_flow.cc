@@ -4,6 +4,9 @@
 #include <chrono>
 #include <numbers>
 
+#include "solver/mesh/p2_element.h"
+#include "solver/quadrature/triangle_rule.h"
+
 namespace capsim::dynamics {
 namespace {
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -25,6 +28,13 @@ CapsuleFlow::CapsuleFlow(const config::CaseConfig& c) : Ca_(c.capillary_number) 
   so.regular_degree = c.regular_degree;
   so.duffy_order = c.duffy_order;
   single_layer_ = std::make_unique<stokes::SingleLayer>(*mesh_, so);
+  volume_correction_ = c.volume_correction;
+  const auto& rule = quadrature::triangle_rule(6);
+  for (int k = 0; k < rule.size(); ++k) {
+    flux_N_.push_back(mesh::p2_shape(rule.points[k][1], rule.points[k][2]));
+    flux_dN_.push_back(mesh::p2_shape_gradients(rule.points[k][1], rule.points[k][2]));
+    flux_w_.push_back(0.5 * rule.weights[k]);
+  }
 }
 
 CapsuleFlow::~CapsuleFlow() = default;
@@ -55,6 +65,26 @@ FlowEvaluation CapsuleFlow::velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd
   v = factor * u_;
   out.max_speed = v.colwise().norm().maxCoeff();
   if (background_flow_) v.row(0) += x.row(1);
+  // Discrete flux of v and of the node normals through the P2 surface; remove the spurious part.
+  normals_ = mesh::node_normals(*mesh_, x);
+  double flux_v = 0.0, flux_n = 0.0;
+  for (const auto& el : mesh_->elements) {
+    for (std::size_t k = 0; k < flux_w_.size(); ++k) {
+      Eigen::Vector3d g1 = Eigen::Vector3d::Zero(), g2 = Eigen::Vector3d::Zero(), vq = Eigen::Vector3d::Zero(),
+                      nq = Eigen::Vector3d::Zero();
+      for (int a = 0; a < 6; ++a) {
+        g1 += flux_dN_[k][0][a] * x.col(el[a]);
+        g2 += flux_dN_[k][1][a] * x.col(el[a]);
+        vq += flux_N_[k][a] * v.col(el[a]);
+        nq += flux_N_[k][a] * normals_.col(el[a]);
+      }
+      const Eigen::Vector3d nda = flux_w_[k] * g1.cross(g2);
+      flux_v += vq.dot(nda);
+      flux_n += nq.dot(nda);
+    }
+  }
+  out.volume_flux = flux_v;
+  if (volume_correction_) v -= (flux_v / flux_n) * normals_;
   if (load) *load = q_;
   ++timings_.evaluations;
   return out;

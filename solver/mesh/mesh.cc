@@ -8,6 +8,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "solver/mesh/p2_element.h"
 #include "solver/quadrature/triangle_rule.h"
 
 namespace capsim::mesh {
@@ -245,6 +246,23 @@ double min_node_spacing(const SurfaceMesh& m, const Eigen::Matrix3Xd& x) {
   for (const auto& e : m.elements)
     for (const auto& p : pairs) h = std::min(h, (x.col(e[p[0]]) - x.col(e[p[1]])).norm());
   return h;
+}
+
+Eigen::Matrix3Xd node_normals(const SurfaceMesh& m, const Eigen::Matrix3Xd& x) {
+  static constexpr double local[6][2] = {{0, 0}, {1, 0}, {0, 1}, {0.5, 0}, {0.5, 0.5}, {0, 0.5}};
+  Eigen::Matrix3Xd n = Eigen::Matrix3Xd::Zero(3, x.cols());
+  for (const auto& el : m.elements)
+    for (int k = 0; k < 6; ++k) {
+      const auto dN = p2_shape_gradients(local[k][0], local[k][1]);
+      Vec3 g1 = Vec3::Zero(), g2 = Vec3::Zero();
+      for (int a = 0; a < 6; ++a) {
+        g1 += dN[0][a] * x.col(el[a]);
+        g2 += dN[1][a] * x.col(el[a]);
+      }
+      n.col(el[k]) += g1.cross(g2).normalized();
+    }
+  n.colwise().normalize();
+  return n;
 }
 
 SpheroidMap parse_spheroid_map(const std::string& name) {

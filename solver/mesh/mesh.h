@@ -83,6 +83,10 @@ MeshQuality mesh_quality(const SurfaceMesh& mesh);
 /// (the h of the explicit stability limit dt ≲ c Ca h).
 double min_node_spacing(const SurfaceMesh& mesh, const Eigen::Matrix3Xd& x);
 
+/// @brief Outward unit normals at the nodes of positions x: the average of the exact P2 normals of the
+/// elements around each node, evaluated at the node.
+Eigen::Matrix3Xd node_normals(const SurfaceMesh& mesh, const Eigen::Matrix3Xd& x);
+
 /// @brief Parse a spheroid-map name ("conformal" | "equal-arc-length" | "axis-scaling").
 /// @throws std::invalid_argument naming the accepted values.
 SpheroidMap parse_spheroid_map(const std::string& name);

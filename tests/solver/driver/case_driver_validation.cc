@@ -53,14 +53,14 @@ TEST(Figure2, ProlateSkalakTumblesAtCa01AndSwingsAtCa09) {
   }
 }
 
-// Volume is conserved by the continuous problem; its drift is discretisation error. Stated bound: 4% over
-// γ̇t = 40 on the level-2 mesh for both laws (measured with Skalak, a/b = 2: −3.8% at Ca = 0.1 and −3.6% at
-// Ca = 0.9 over γ̇t = 60 on level 2; −1.2% at Ca = 0.9 on level 3).
+// Volume is conserved by the continuous problem. Without the flux correction the level-2 mesh loses
+// 3.6–3.8% over γ̇t = 60 (Skalak, a/b = 2, Ca = 0.1 and 0.9); with it (the default) the stated bound is
+// 1e-3 over γ̇t = 40 for both laws (measured: ≤ 4e-5 in the quick Table 1 campaign).
 TEST(VolumeDrift, BoundedForBothLaws) {
   for (const char* law : {"neo-hookean", "skalak"}) {
     const CaseResult r = run_figure2(0.3, law, std::string("drift_") + law);
     ASSERT_NE(r.status, "unstable") << r.reason;
-    EXPECT_LT(std::abs(r.volume_drift), 0.04) << law;
+    EXPECT_LT(std::abs(r.volume_drift), 1e-3) << law;
   }
 }
 

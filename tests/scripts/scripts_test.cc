@@ -21,8 +21,13 @@ TEST(Scripts, Table1PrintsOursBesideTheSeed) {
   const CmdResult r = sh("/usr/bin/python3 " + std::string(CAPSIM_SOURCE_DIR) + "/scripts/table1 --db " + db() +
                          " --capsim " + exe());
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("| NH | 2.0 | [0.20, 0.25] | [0.20, 0.25] | overlap"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("| Sk C=1 | 1.0 |"), std::string::npos) << r.out;
+  // Layout of the seed's Table 1 (a Ca* and a CaH row per law, one column per a/b), seed values beside ours.
+  EXPECT_NE(r.out.find("| law | | a/b = 0.5 | a/b = 1 | a/b = 2 |"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("| NH | Ca* |"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("| Sk, C = 1 | Ca* |"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("seed [0.20, 0.25]"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Agree: "), std::string::npos) << r.out;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << "capsim query and the database read differ: " << r.err;
   const CmdResult bad = sh("/usr/bin/python3 " + std::string(CAPSIM_SOURCE_DIR) + "/scripts/table1 --db /nonexistent.sqlite --capsim " + exe());
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("/nonexistent.sqlite"), std::string::npos);

@@ -71,7 +71,8 @@ class ScriptsTest : public ::testing::Test {
       skip_reason_ = "/usr/bin/python3 lacks matplotlib/h5py/numpy (run scripts/setup): " + probe.err;
       return;
     }
-    dir_ = tmp_root() / "fixture";
+    // One fixture per process: ctest runs the tests of this suite as parallel processes.
+    dir_ = tmp_root() / ("fixture_" + std::to_string(getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     const Cmd run = sh(std::string(CAPSIM_EXE_PATH) + " run " +

@@ -7,6 +7,7 @@
 #include "capsim/version.h"
 #include "solver/diagnostics/material_point.h"
 #include "solver/diagnostics/time_series.h"
+#include "solver/diagnostics/wrinkle.h"
 #include "solver/dynamics/capsule_flow.h"
 #include "solver/dynamics/time_stepper.h"
 #include "solver/io/case_file.h"
@@ -44,6 +45,27 @@ void write_snapshot(io::CaseWriter& writer, dynamics::CapsuleFlow& flow, const E
   writer.write_snapshot(t, step, flow.mesh(), x, fields);
 }
 
+// Wrinkle indicators of state x (one extra flow evaluation for the load). A state the membrane rejects
+// (collapsed element) has none.
+std::optional<diagnostics::WrinkleIndicators> measure_wrinkle(dynamics::CapsuleFlow& flow, const Eigen::Matrix3Xd& x,
+                                                              int membrane_degree) {
+  try {
+    Eigen::Matrix3Xd v, q;
+    flow.velocity(x, v, &q);
+    diagnostics::WrinkleIndicators w;
+    w.compressed_area_fraction = diagnostics::compressed_area_fraction(
+        flow.mesh(), x, flow.mechanics().principal_tensions(x), membrane_degree);
+    w.load_roughness = diagnostics::load_roughness(flow.mesh(), x, q);
+    return w;
+  } catch (const membrane::DegenerateSurface&) {
+    return std::nullopt;
+  }
+}
+
+// Wrinkle indicators are sampled on this fixed time grid (units of 1/γ̇): often enough to catch a
+// transient, rare enough to cost < 1% of the flow evaluations.
+constexpr double kWrinkleInterval = 1.0;
+
 }  // namespace
 
 CaseResult run_case(const config::CaseConfig& config, const RunOptions& options) {
@@ -64,6 +86,7 @@ CaseResult run_case(const config::CaseConfig& config, const RunOptions& options)
   diagnostics::TimeSeries series;
   int p_node = diagnostics::choose_material_point(mesh, x);
   const std::string identity = config.to_toml();
+  diagnostics::WrinkleIndicators wrinkle_max;  // largest sampled values over the run
 
   std::optional<io::CaseWriter> writer;
   if (options.resume && std::filesystem::exists(checkpoint_file)) {
@@ -75,6 +98,8 @@ CaseResult run_case(const config::CaseConfig& config, const RunOptions& options)
     step = cp.step;
     series = cp.series;
     p_node = static_cast<int>(cp.scalars["p_node"]);
+    wrinkle_max.compressed_area_fraction = cp.scalars["max_compressed_area_fraction"];
+    wrinkle_max.load_roughness = cp.scalars["max_load_roughness"];
     writer.emplace(io::CaseWriter::resume(case_file, case_attributes(config), series));
   } else {
     writer.emplace(case_file, case_attributes(config));
@@ -88,6 +113,8 @@ CaseResult run_case(const config::CaseConfig& config, const RunOptions& options)
     cp.dt = dt;
     cp.series = series;
     cp.scalars["p_node"] = p_node;
+    cp.scalars["max_compressed_area_fraction"] = wrinkle_max.compressed_area_fraction;
+    cp.scalars["max_load_roughness"] = wrinkle_max.load_roughness;
     cp.strings["case"] = identity;
     io::write_checkpoint(checkpoint_file, cp);
   };
@@ -107,6 +134,15 @@ CaseResult run_case(const config::CaseConfig& config, const RunOptions& options)
   double next_checkpoint = after(config.checkpoint_interval);
   double next_snapshot = at_or_after(config.snapshot_interval);
   double next_sample = config.sample_interval > 0 ? at_or_after(config.sample_interval) : t;
+  double next_wrinkle = after(kWrinkleInterval);
+  auto sample_wrinkle = [&](const Eigen::Matrix3Xd& state) {
+    if (const auto w = measure_wrinkle(flow, state, config.membrane_degree)) {
+      wrinkle_max.compressed_area_fraction = std::max(wrinkle_max.compressed_area_fraction, w->compressed_area_fraction);
+      wrinkle_max.load_roughness = std::max(wrinkle_max.load_roughness, w->load_roughness);
+      return *w;
+    }
+    return diagnostics::WrinkleIndicators{};
+  };
   const long first_step = step;
   auto last_progress = Clock::now();
   diagnostics::ConvergenceOptions conv;
@@ -165,6 +201,10 @@ CaseResult run_case(const config::CaseConfig& config, const RunOptions& options)
     ++step;
     t = step * dt;  // no drift from repeated additions
 
+    if (t >= next_wrinkle - eps) {
+      next_wrinkle += kWrinkleInterval;
+      sample_wrinkle(x);
+    }
     if (t >= next_check - eps) {
       next_check += config.check_interval;
       r.analysis = diagnostics::analyse_periods(series);
@@ -187,6 +227,8 @@ CaseResult run_case(const config::CaseConfig& config, const RunOptions& options)
   }
 
   // --- Output: final analysis and summary attributes.
+  r.wrinkle_final = sample_wrinkle(x);
+  r.wrinkle_max = wrinkle_max;
   if (!series.empty()) r.analysis = diagnostics::analyse_periods(series);
   const double V = membrane::area_and_volume(mesh, x).volume;
   r.volume_drift = (V - V0) / V0;
@@ -209,6 +251,10 @@ CaseResult run_case(const config::CaseConfig& config, const RunOptions& options)
   writer->set_attribute({"steps", r.steps});
   writer->set_attribute({"dt", r.dt});
   writer->set_attribute({"t_final", r.t_final});
+  writer->set_attribute({"compressed_area_fraction", r.wrinkle_final.compressed_area_fraction});
+  writer->set_attribute({"load_roughness", r.wrinkle_final.load_roughness});
+  writer->set_attribute({"max_compressed_area_fraction", r.wrinkle_max.compressed_area_fraction});
+  writer->set_attribute({"max_load_roughness", r.wrinkle_max.load_roughness});
   writer->close();
   r.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
   return r;

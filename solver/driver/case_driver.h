@@ -11,6 +11,7 @@
 
 #include "solver/config/case_config.h"
 #include "solver/diagnostics/period_analysis.h"
+#include "solver/diagnostics/wrinkle.h"
 
 namespace capsim::driver {
 
@@ -40,6 +41,9 @@ struct CaseResult {
   bool converged = false;            ///< periodic (or steady) regime reached before t_end
   diagnostics::PeriodAnalysis analysis;
   double volume_drift = 0;           ///< (V(t_final) − V0)/V0
+  /// Wrinkle indicators (diagnostics/wrinkle.h) of the final state, and their largest values sampled
+  /// every time unit over the run (carried through checkpoints).
+  diagnostics::WrinkleIndicators wrinkle_final, wrinkle_max;
   long steps = 0;
   long flow_evaluations = 0;
   double dt = 0;

@@ -112,6 +112,9 @@ int run_command(const std::vector<std::string>& args) {
                  a.mean_D12, r.volume_drift);
     std::fprintf(stderr, "# phases: membrane %.1f s, load %.1f s, boundary integral %.1f s\n", r.membrane_s, r.load_s,
                  r.stokes_s);
+    std::fprintf(stderr, "# wrinkle indicators (final / largest sampled): compressed area %.3f / %.3f, q.n roughness %.3f / %.3f\n",
+                 r.wrinkle_final.compressed_area_fraction, r.wrinkle_max.compressed_area_fraction,
+                 r.wrinkle_final.load_roughness, r.wrinkle_max.load_roughness);
   }
   if (json) {
     nlohmann::json j = {
@@ -129,6 +132,10 @@ int run_command(const std::vector<std::string>& args) {
         {"regime", std::string(diagnostics::to_string(a.regime))},
         {"converged", r.converged},
         {"volume_drift", r.volume_drift},
+        {"compressed_area_fraction", json_number(r.wrinkle_final.compressed_area_fraction)},
+        {"load_roughness", json_number(r.wrinkle_final.load_roughness)},
+        {"max_compressed_area_fraction", json_number(r.wrinkle_max.compressed_area_fraction)},
+        {"max_load_roughness", json_number(r.wrinkle_max.load_roughness)},
         {"steps", r.steps},
         {"flow_evaluations", r.flow_evaluations},
         {"dt", r.dt},

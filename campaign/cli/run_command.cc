@@ -121,6 +121,7 @@ int run_command(const std::vector<std::string>& args) {
         {"status", r.status},
         {"reason", r.reason},
         {"capillary_number", config.capillary_number},
+        {"Ca", config.capillary_number},  // the name DESIGN.md §8 promises; capillary_number is the long one
         {"aspect_ratio", config.aspect_ratio},
         {"law", config.law},
         {"skalak_C", config.skalak_C},

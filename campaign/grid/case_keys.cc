@@ -27,6 +27,8 @@ const std::vector<CaseKey>& case_keys() {
       {"numerics.duffy_order", KeyType::kInt, std::nullopt, true, "Gauss points per direction, singular integrals"},
       {"numerics.membrane_degree", KeyType::kInt, std::nullopt, true, "membrane/mass-matrix triangle rule: 4, 5, 6"},
       {"numerics.volume_correction", KeyType::kBool, std::nullopt, true, "remove the discrete volume flux (true/false)"},
+      {"numerics.far_degree", KeyType::kInt, std::nullopt, true, "boundary-integral far-field rule: 0 (off), 1, 2"},
+      {"numerics.far_radius", KeyType::kFloat, std::nullopt, true, "far-field threshold in element radii, > 1"},
       {"output.snapshot_interval", KeyType::kFloat, Value{0.0}, false, "time between snapshots, 0 = none"},
       {"output.checkpoint_interval", KeyType::kFloat, std::nullopt, false, "time between checkpoints"},
       {"output.sample_interval", KeyType::kFloat, std::nullopt, true, "time-series sampling (0 = every step)"},
@@ -80,6 +82,11 @@ std::string check_case_value(const CaseKey& key, const Value& value) {
     if (auto x = num(); x && !(*x > 0)) return "must be > 0 (got " + value_to_text(value) + ")";
   } else if (n == "time.period_tolerance" || n == "time.check_interval") {
     if (auto x = num(); x && !(*x > 0)) return "must be > 0 (got " + value_to_text(value) + ")";
+  } else if (n == "numerics.far_degree") {
+    if (auto* d = std::get_if<std::int64_t>(&value); d && (*d < 0 || *d > 2))
+      return "must be 0, 1 or 2 (got " + std::to_string(*d) + ")";
+  } else if (n == "numerics.far_radius") {
+    if (auto x = num(); x && !(*x > 1)) return "must be > 1 (got " + value_to_text(value) + ")";
   } else if (n == "time.volume_tolerance") {
     if (auto x = num(); x && !(*x > 0 && *x < 1)) return "must be in (0, 1) (got " + value_to_text(value) + ")";
   } else if (n == "output.snapshot_interval" || n == "output.checkpoint_interval" || n == "output.sample_interval") {

@@ -75,6 +75,8 @@ const std::vector<KeySpec>& key_specs() {
       {"numerics", "duffy_order", [](auto& n, auto& c, auto& w) { c.duffy_order = as_int(n, w); }},
       {"numerics", "membrane_degree", [](auto& n, auto& c, auto& w) { c.membrane_degree = as_int(n, w); }},
       {"numerics", "volume_correction", [](auto& n, auto& c, auto& w) { c.volume_correction = as_bool(n, w); }},
+      {"numerics", "far_degree", [](auto& n, auto& c, auto& w) { c.far_degree = as_int(n, w); }},
+      {"numerics", "far_radius", [](auto& n, auto& c, auto& w) { c.far_radius = as_number(n, w); }},
       {"output", "snapshot_interval", [](auto& n, auto& c, auto& w) { c.snapshot_interval = as_number(n, w); }},
       {"output", "checkpoint_interval", [](auto& n, auto& c, auto& w) { c.checkpoint_interval = as_number(n, w); }},
       {"output", "sample_interval", [](auto& n, auto& c, auto& w) { c.sample_interval = as_number(n, w); }},
@@ -157,6 +159,8 @@ void CaseConfig::validate() const {
   for (auto [key, v] : {std::pair{"numerics.regular_degree", regular_degree}, {"numerics.membrane_degree", membrane_degree}})
     require(v >= 4 && v <= 6, key, v, "4, 5 or 6");
   require(duffy_order >= 2 && duffy_order <= 64, "numerics.duffy_order", duffy_order, "2..64");
+  require(far_degree >= 0 && far_degree <= 2, "numerics.far_degree", far_degree, "0 (off), 1 or 2");
+  require(std::isfinite(far_radius) && far_radius > 1.0, "numerics.far_radius", far_radius, "must be > 1");
   require(snapshot_interval >= 0.0, "output.snapshot_interval", snapshot_interval, "must be >= 0");
   require(checkpoint_interval >= 0.0, "output.checkpoint_interval", checkpoint_interval, "must be >= 0");
   require(sample_interval >= 0.0, "output.sample_interval", sample_interval, "must be >= 0");
@@ -182,6 +186,8 @@ std::map<std::string, std::string> CaseConfig::to_map() const {
       {"numerics.duffy_order", std::to_string(duffy_order)},
       {"numerics.membrane_degree", std::to_string(membrane_degree)},
       {"numerics.volume_correction", volume_correction ? "true" : "false"},
+      {"numerics.far_degree", std::to_string(far_degree)},
+      {"numerics.far_radius", fmt_double(far_radius)},
       {"output.snapshot_interval", fmt_double(snapshot_interval)},
       {"output.checkpoint_interval", fmt_double(checkpoint_interval)},
       {"output.sample_interval", fmt_double(sample_interval)},

@@ -40,8 +40,10 @@ struct CaseConfig {
   // [numerics]
   int regular_degree = 4;              ///< triangle rule of the boundary integral (4, 5, 6)
   int duffy_order = 8;                 ///< Gauss points per direction of the singular integrals
-  int membrane_degree = 6;
-  bool volume_correction = true;       ///< remove the discrete flux ∫ v·n dS (see dynamics::CapsuleFlow)             ///< triangle rule of the membrane and mass matrix (4, 5, 6)
+  int membrane_degree = 6;             ///< triangle rule of the membrane and mass matrix (4, 5, 6)
+  bool volume_correction = true;       ///< remove the discrete flux ∫ v·n dS (see dynamics::CapsuleFlow)
+  int far_degree = 0;                  ///< far-field rule of the boundary integral: 0 = off, 1, 2 (see stokes)
+  double far_radius = 4.0;             ///< elements beyond far_radius · their radius get the far rule; > 1
   // [output]
   double snapshot_interval = 0.0;      ///< 0 = no snapshots
   double checkpoint_interval = 5.0;    ///< time units between checkpoints (0 = only at the end / interrupt)

@@ -27,6 +27,8 @@ CapsuleFlow::CapsuleFlow(const config::CaseConfig& c) : Ca_(c.capillary_number) 
   stokes::SingleLayerOptions so;
   so.regular_degree = c.regular_degree;
   so.duffy_order = c.duffy_order;
+  so.far_degree = c.far_degree;
+  so.far_radius = c.far_radius;
   single_layer_ = std::make_unique<stokes::SingleLayer>(*mesh_, so);
   volume_correction_ = c.volume_correction;
   const auto& rule = quadrature::triangle_rule(6);

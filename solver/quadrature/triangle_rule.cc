@@ -121,6 +121,17 @@ TriangleRule polish(int degree, std::vector<Orbit> orbits) {
   return build(degree, orbits);
 }
 
+TriangleRule make_degree1() {
+  // Centroid rule: exact for linear functions (the far-field tier of the boundary integral).
+  return build(1, {{1, 1.0, 0.0, 0.0}});
+}
+
+TriangleRule make_degree2() {
+  // Strang–Fix 3-point rule with interior points (2/3, 1/6, 1/6): exact to degree 2. The interior variant
+  // (rather than the edge-midpoint one) keeps the points off the edges shared with neighbouring elements.
+  return build(2, {{3, 1.0 / 3.0, 2.0 / 3.0, 0.0}});
+}
+
 TriangleRule make_degree4() {
   // Dunavant (1985), 6 points (DESIGN.md §6).
   return polish(4, {{3, 0.223381589678011, 0.108103018168070, 0.0},
@@ -145,10 +156,14 @@ TriangleRule make_degree6() {
 }  // namespace
 
 const TriangleRule& triangle_rule(int degree) {
+  static const TriangleRule r1 = make_degree1();
+  static const TriangleRule r2 = make_degree2();
   static const TriangleRule r4 = make_degree4();
   static const TriangleRule r5 = make_degree5();
   static const TriangleRule r6 = make_degree6();
   switch (degree) {
+    case 1: return r1;
+    case 2: return r2;
     case 4: return r4;
     case 5: return r5;
     case 6: return r6;

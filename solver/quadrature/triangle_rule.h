@@ -20,7 +20,8 @@ struct TriangleRule {
   [[nodiscard]] int size() const { return static_cast<int>(weights.size()); }
 };
 
-/// @brief The rule of exactly this degree: 4 (6 points), 5 (7 points) or 6 (12 points).
+/// @brief The rule of exactly this degree: 1 (1 point, centroid), 2 (3 interior points), 4 (6 points),
+/// 5 (7 points) or 6 (12 points). Degrees 1 and 2 serve the far-field tier of the boundary integral.
 /// @throws std::invalid_argument for any other degree.
 const TriangleRule& triangle_rule(int degree);
 

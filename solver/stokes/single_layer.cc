@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <omp.h>
+
 #include "solver/mesh/p2_element.h"
 #include "solver/quadrature/triangle_rule.h"
 
@@ -42,7 +44,16 @@ const std::vector<SubTriangle>& sub_triangles(int local) {
 }  // namespace
 
 SingleLayer::SingleLayer(const mesh::SurfaceMesh& mesh, const SingleLayerOptions& options) : opt_(options) {
+  // Degrees 1 and 2 exist only as far-field rules: the regular and near rules must stay accurate near targets.
+  if (opt_.regular_degree < 4 || opt_.near_degree < 4)
+    throw std::invalid_argument("stokes: regular_degree and near_degree must be 4, 5 or 6");
   const auto& rule = quadrature::triangle_rule(opt_.regular_degree);  // throws for a bad degree
+  if (opt_.far_degree < 0 || opt_.far_degree > 2)
+    throw std::invalid_argument("stokes: far_degree must be 0 (off), 1 or 2, got " + std::to_string(opt_.far_degree));
+  // far_radius ≤ 1 would call elements far from their own nodes' neighbourhood (|x0 − c_e| ≤ ρ_e for a node
+  // of e); the own elements are always treated as mid anyway, but such a radius is surely a mistake.
+  if (!(opt_.far_radius > 1.0) || !std::isfinite(opt_.far_radius))
+    throw std::invalid_argument("stokes: far_radius must be a finite number > 1");
   if (opt_.duffy_order < 1)
     throw std::invalid_argument("stokes: duffy_order must be >= 1, got " + std::to_string(opt_.duffy_order));
   if (!(opt_.symmetry_tol >= 0.0)) throw std::invalid_argument("stokes: symmetry_tol must be >= 0");
@@ -123,6 +134,19 @@ SingleLayer::SingleLayer(const mesh::SurfaceMesh& mesh, const SingleLayerOptions
         t.deta[a].push_back(sa.deta[a]);
       }
     for (const ShapeAt& sa : duffy_[l]) t.w.push_back(sa.w);
+  }
+
+  if (opt_.far_degree > 0) {
+    // Coarse rule for the all-pairs sum, and the per-element block that upgrades it to the regular rule:
+    // the regular points, then the coarse points with negated weights (one contiguous add_block per element).
+    const auto& far_rule = quadrature::triangle_rule(opt_.far_degree);
+    for (int k = 0; k < far_rule.size(); ++k)
+      coarse_.push_back(shape_at(far_rule.points[k][1], far_rule.points[k][2], 0.5 * far_rule.weights[k]));
+    mid_rule_ = regular_;
+    for (const ShapeAt& c : coarse_) {
+      mid_rule_.push_back(c);
+      mid_rule_.back().w = -c.w;
+    }
   }
 
   if (opt_.near_subdivision > 0) {
@@ -259,8 +283,173 @@ inline void add_block(const double x0[3], const double* px, const double* py, co
 }
 }  // namespace
 
+void SingleLayer::build_centroid_grid(const Eigen::Matrix3Xd& x) {
+  const int ne = num_elements();
+  for (auto* v : {&cx_, &cy_, &cz_, &rho_}) v->resize(static_cast<std::size_t>(ne));
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, rmax = 0.0;
+  for (int e = 0; e < ne; ++e) {
+    const auto& el = elements_[e];
+    double c[3] = {0.0, 0.0, 0.0};
+    for (int a = 0; a < 6; ++a)
+      for (int k = 0; k < 3; ++k) c[k] += x(k, el[a]);
+    for (double& ck : c) ck /= 6.0;
+    double r2 = 0.0;
+    for (int a = 0; a < 6; ++a) {
+      const double dx = x(0, el[a]) - c[0], dy = x(1, el[a]) - c[1], dz = x(2, el[a]) - c[2];
+      r2 = std::max(r2, dx * dx + dy * dy + dz * dz);
+    }
+    cx_[e] = c[0];
+    cy_[e] = c[1];
+    cz_[e] = c[2];
+    rho_[e] = std::sqrt(r2);
+    rmax = std::max(rmax, rho_[e]);
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], c[k]);
+      hi[k] = std::max(hi[k], c[k]);
+    }
+  }
+  // Every mid element of a target has its centroid within far_reach_ of it; cells of half that size make
+  // the search box (at most 5 cells per direction) hug the ball more tightly than 3 cells of the full size
+  // (fewer candidates to test). The cell count is capped near 2 N (enlarging the cells) so a thin or very
+  // fine surface cannot blow up the grid.
+  far_reach_ = opt_.far_radius * rmax;
+  double ext = 0.0;
+  for (int k = 0; k < 3; ++k) ext = std::max(ext, hi[k] - lo[k]);
+  double cell = far_reach_ > 0.0 ? 0.5 * far_reach_ : ext + 1.0;
+  if (!(cell > 0.0) || !std::isfinite(cell)) cell = 1.0;  // NaN positions: any grid; NaN then propagates
+  auto cells = [&](double h) {
+    long long n = 1;
+    for (int k = 0; k < 3; ++k) {
+      const double span = hi[k] - lo[k];
+      grid_dim_[k] = std::isfinite(span) ? static_cast<int>(std::min(span / h, 1e6)) + 1 : 1;
+      n *= grid_dim_[k];
+    }
+    return n;
+  };
+  while (cells(cell) > 2LL * ne + 8) cell *= 1.25;
+  grid_cell_ = cell;
+  for (int k = 0; k < 3; ++k) grid_lo_[k] = std::isfinite(lo[k]) ? lo[k] : 0.0;
+  const int ncell = grid_dim_[0] * grid_dim_[1] * grid_dim_[2];
+  auto index = [&](double p, int k) {
+    const double f = std::floor((p - grid_lo_[k]) / grid_cell_);
+    return f >= 0.0 ? static_cast<int>(std::min(f, static_cast<double>(grid_dim_[k] - 1))) : 0;  // NaN → 0
+  };
+  // Counting sort of the elements by cell: slot j (cell order) holds element cell_elements_[j].
+  cell_offsets_.assign(static_cast<std::size_t>(ncell) + 1, 0);
+  cell_elements_.resize(static_cast<std::size_t>(ne));
+  cell_cursor_.resize(static_cast<std::size_t>(ne));
+  for (int e = 0; e < ne; ++e) {
+    const int id = (index(cz_[e], 2) * grid_dim_[1] + index(cy_[e], 1)) * grid_dim_[0] + index(cx_[e], 0);
+    cell_cursor_[e] = id;
+    ++cell_offsets_[id + 1];
+  }
+  for (int c = 0; c < ncell; ++c) cell_offsets_[c + 1] += cell_offsets_[c];
+  cell_fill_.assign(cell_offsets_.begin(), cell_offsets_.end() - 1);
+  for (int e = 0; e < ne; ++e) cell_elements_[cell_fill_[cell_cursor_[e]]++] = e;
+  // Everything the per-target search touches is stored in slot order: a target's candidates are one
+  // contiguous range per row of cells, and its mid blocks merge into a few contiguous loops (no gathers).
+  slot_.resize(static_cast<std::size_t>(ne));
+  sorted_elements_.resize(static_cast<std::size_t>(ne));
+  for (auto* v : {&scx_, &scy_, &scz_, &sreach2_}) v->resize(static_cast<std::size_t>(ne));
+  for (int j = 0; j < ne; ++j) {
+    const int e = cell_elements_[j];
+    slot_[e] = j;
+    sorted_elements_[j] = elements_[e];
+    scx_[j] = cx_[e];
+    scy_[j] = cy_[e];
+    scz_[j] = cz_[e];
+    sreach2_[j] = opt_.far_radius * opt_.far_radius * rho_[e] * rho_[e];
+  }
+}
+
+long long SingleLayer::mid_correction(const std::vector<int>& targets, const Eigen::Matrix3Xd& x,
+                                      Eigen::Matrix3Xd& u) {
+  const int nt = static_cast<int>(targets.size()), ne = num_elements();
+  const int nm = static_cast<int>(mid_rule_.size());
+  // Per-thread scratch, sized for the worst case so the target loop never allocates: stamps (mark[j] == i:
+  // slot j is already listed for target i; targets are distinct, so no reset is needed within a call, stale
+  // stamps of the last call are cleared here) and the mid slots of the current target.
+  const int nthreads = std::max(1, omp_get_max_threads());
+  if (static_cast<int>(mark_.size()) < nthreads) mark_.resize(static_cast<std::size_t>(nthreads));
+  if (static_cast<int>(slots_.size()) < nthreads) slots_.resize(static_cast<std::size_t>(nthreads));
+  for (auto& m : mark_) m.assign(static_cast<std::size_t>(ne), -1);
+  for (auto& c : slots_) c.resize(static_cast<std::size_t>(ne) + 1);
+  const double *mx = mx_.data(), *my = my_.data(), *mz = mz_.data(), *mqx = mqx_.data(), *mqy = mqy_.data(),
+               *mqz = mqz_.data();
+  const double *cx = scx_.data(), *cy = scy_.data(), *cz = scz_.data(), *reach2 = sreach2_.data();
+  const int* slot = slot_.data();
+  long long total = 0;
+#pragma omp parallel reduction(+ : total)
+  {
+    const int thread = omp_get_thread_num();
+    int* mark = mark_[static_cast<std::size_t>(thread)].data();
+    int* mid = slots_[static_cast<std::size_t>(thread)].data();
+#pragma omp for schedule(dynamic, 16)
+    for (int it = 0; it < nt; ++it) {
+      const int i = targets[it];
+      const double x0[3] = {x(0, i), x(1, i), x(2, i)};
+      // Collect the mid slots first, then sum their blocks: one add_block per element costs a horizontal
+      // reduction and a masked remainder each (measured ~10× slower per interaction than the all-pairs
+      // kernel); consecutive slots are merged into one contiguous loop (~5% fewer cycles than gathering).
+      int nc = 0;
+      auto always = [&](int j) {  // j: slot of the element
+        if (mark[j] == i) return;
+        mark[j] = i;
+        mid[nc++] = j;
+      };
+      // The own elements and near-singular neighbours first: the corrections after this step remove
+      // exactly the regular rule from them, whatever their distance.
+      for (int k = node_offsets_[i]; k < node_offsets_[i + 1]; ++k) always(slot[inc_element_[k]]);
+      if (!near_offsets_.empty())
+        for (int k = near_offsets_[i]; k < near_offsets_[i + 1]; ++k) always(slot[near_elements_[k]]);
+      int lo[3], hi[3];
+      for (int k = 0; k < 3; ++k) {
+        const double a = std::floor((x0[k] - far_reach_ - grid_lo_[k]) / grid_cell_);
+        const double b = std::floor((x0[k] + far_reach_ - grid_lo_[k]) / grid_cell_);
+        lo[k] = a > 0.0 ? static_cast<int>(std::min(a, grid_dim_[k] - 1.0)) : 0;
+        hi[k] = b > 0.0 ? static_cast<int>(std::min(b, grid_dim_[k] - 1.0)) : 0;
+      }
+      for (int iz = lo[2]; iz <= hi[2]; ++iz)
+        for (int iy = lo[1]; iy <= hi[1]; ++iy) {
+          const int row = (iz * grid_dim_[1] + iy) * grid_dim_[0];
+          // Branch-free append (the mid/far outcome is unpredictable); the cells are disjoint, so only the
+          // slots listed above can come twice. mid has room for one write past the last element.
+          for (int j = cell_offsets_[row + lo[0]]; j < cell_offsets_[row + hi[0] + 1]; ++j) {
+            const double dx = x0[0] - cx[j], dy = x0[1] - cy[j], dz = x0[2] - cz[j];
+            mid[nc] = j;
+            nc += static_cast<int>(dx * dx + dy * dy + dz * dz <= reach2[j]) & static_cast<int>(mark[j] != i);
+          }
+        }
+      total += nc;
+      std::sort(mid, mid + nc);
+      double ax = 0.0, ay = 0.0, az = 0.0;
+      for (int c = 0; c < nc;) {
+        int d = c + 1;
+        while (d < nc && mid[d] == mid[d - 1] + 1) ++d;
+        const int pb = mid[c] * nm, pe = (mid[d - 1] + 1) * nm;
+        c = d;
+#pragma omp simd reduction(+ : ax, ay, az)
+        for (int p = pb; p < pe; ++p) {
+          const double dx = x0[0] - mx[p], dy = x0[1] - my[p], dz = x0[2] - mz[p];
+          const double r2 = dx * dx + dy * dy + dz * dz;
+          const double inv = r2 == 0.0 ? 0.0 : kernel::rsqrt_arith(r2);
+          const double sc = (dx * mqx[p] + dy * mqy[p] + dz * mqz[p]) * inv * inv * inv;
+          ax += mqx[p] * inv + dx * sc;
+          ay += mqy[p] * inv + dy * sc;
+          az += mqz[p] * inv + dz * sc;
+        }
+      }
+      u(0, i) += ax;
+      u(1, i) += ay;
+      u(2, i) += az;
+    }
+  }
+  return total;
+}
+
 void SingleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q,
-                                      const std::vector<int>& targets, Eigen::Matrix3Xd& u) const {
+                                      const std::vector<int>& targets, const double* const reg[6], int stride,
+                                      const int* slot, Eigen::Matrix3Xd& u) const {
   const int nt = static_cast<int>(targets.size()), nq = rule_size_;
   const int nr = static_cast<int>(near_rule_.size());
 #pragma omp parallel for schedule(dynamic, 16)
@@ -272,8 +461,8 @@ void SingleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Ma
       const int e = inc_element_[k], l = inc_local_[k];
       const auto& el = elements_[e];
       // Remove what the regular rule counted for this element ...
-      add_block(x0, sx_.data(), sy_.data(), sz_.data(), sqx_.data(), sqy_.data(), sqz_.data(), e * nq, (e + 1) * nq,
-                -1.0, acc);
+      const int b = (slot != nullptr ? slot[e] : e) * stride;
+      add_block(x0, reg[0], reg[1], reg[2], reg[3], reg[4], reg[5], b, b + nq, -1.0, acc);
       // ... and add the Duffy integral with the node at the apex. Positions relative to x0 (Σ N_a = 1)
       // avoid cancellation near the apex.
       double R[6][3], Q[6][3];
@@ -347,7 +536,15 @@ void SingleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Ei
       throw std::invalid_argument("stokes: symmetry forced on but the scene is not symmetric under x3 -> -x3");
   }
 
-  const kernel::Sources src = build_sources(x, q);
+  // With the far-field tier the all-pairs sum runs over the coarse rule; without it, over the regular rule.
+  const bool far = opt_.far_degree > 0;
+  kernel::Sources src;
+  if (far) {
+    layout(coarse_, elements_, x, q, sx_, sy_, sz_, sqx_, sqy_, sqz_, kernel::simd_width());
+    src = {sx_.data(), sy_.data(), sz_.data(), sqx_.data(), sqy_.data(), sqz_.data(), static_cast<int>(sx_.size())};
+  } else {
+    src = build_sources(x, q);
+  }
   const double t1 = now_s();
 
   // Targets: all nodes, or one of each mirror pair (the one with the larger x3; a node on the plane is its
@@ -382,8 +579,25 @@ void SingleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Ei
     u(1, target_ids_[k]) = uy_[k];
     u(2, target_ids_[k]) = uz_[k];
   }
+  // Far-field tier: mid elements (and the own/near ones) upgraded from the coarse to the regular rule. The
+  // singular correction then finds the regular points of each element in the mid layout (first nq of each
+  // block) instead of the all-pairs sources.
+  long long mids = 0;
+  const double* reg[6] = {sx_.data(), sy_.data(), sz_.data(), sqx_.data(), sqy_.data(), sqz_.data()};
+  int stride = rule_size_;
+  const int* slot = nullptr;
+  if (far) {
+    build_centroid_grid(x);
+    layout(mid_rule_, sorted_elements_, x, q, mx_, my_, mz_, mqx_, mqy_, mqz_, 1);
+    slot = slot_.data();
+    mids = mid_correction(target_ids_, x, u);
+    const double* m[6] = {mx_.data(), my_.data(), mz_.data(), mqx_.data(), mqy_.data(), mqz_.data()};
+    std::copy(m, m + 6, reg);
+    stride = static_cast<int>(mid_rule_.size());
+  }
+  const double t2f = now_s();
   if (!near_rule_.empty()) layout(near_rule_, elements_, x, q, nx_, ny_, nz_, nqx_, nqy_, nqz_, 1);
-  singular_correction(x, q, target_ids_, u);
+  singular_correction(x, q, target_ids_, reg, stride, slot, u);
   if (sym) {
     for (int k = 0; k < nt; ++k) {
       const int i = target_ids_[k], m = mirror_[i];
@@ -397,10 +611,12 @@ void SingleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Ei
 
   stats_.used_symmetry = sym;
   stats_.targets = nt;
-  stats_.sources = num_quadrature_points();
+  stats_.sources = num_elements() * static_cast<int>(far ? coarse_.size() : regular_.size());
+  stats_.mid_elements = mids;
   stats_.build_s = t1 - t0;
   stats_.regular_s = t2 - t1;
-  stats_.singular_s = t3 - t2;
+  stats_.far_s = far ? t2f - t2 : 0.0;
+  stats_.singular_s = far ? t3 - t2f : t3 - t2;
   stats_.total_s = t3 - t0;
 }
 

@@ -14,6 +14,22 @@
 ///  - Regular part: one triangle rule (degree 4/5/6) on every element; all quadrature points of the surface
 ///    are laid out once per call as structure-of-arrays (x, y, z and w·|∂x/∂ξ × ∂x/∂η|·q), padded to the
 ///    SIMD width with zero loads, and summed for all targets by kernel::sum_fast (or sum_plain).
+///  - Far-field tier (Options::far_degree > 0; off by default): the all-pairs sum above uses a COARSE rule
+///    (degree 1: centroid, or degree 2: 3 points) on every element instead. An element e is "far" from a
+///    target x0 when |x0 − c_e| > far_radius · ρ_e (c_e the mean of its 6 nodes, ρ_e their largest distance
+///    from c_e); for it the coarse rule is the final answer. Every other ("mid") element, and always the
+///    target's own elements and near-singular neighbours, gets one contiguous block "regular rule minus
+///    coarse rule" (the coarse points with negated weights) added per target, so after this step the sum is
+///    exactly the regular-rule sum on all non-far elements and the corrections below apply unchanged. The
+///    mid elements of a target are found with a uniform grid of element centroids (cell = ½ far_radius ·
+///    max ρ_e), rebuilt every call in O(N) because the geometry moves between calls; the mid blocks are
+///    laid out in the grid's cell order so that a target's blocks form a few contiguous runs.
+///    Accuracy: the coarse rule's relative error on an element at distance d is ~ (ρ_e/d)^(far_degree+1);
+///    summed over the surface the far-field error is ~ ρ · far_radius^(−far_degree), i.e. only O(h) at a
+///    fixed radius (the method itself converges at order ~3). Measured (tests/benchmarks/stokes_bench.cc,
+///    deformed surface, levels 2–4): degree 1 costs 25–100× the discretisation error at any radius; degree 2
+///    at radius 4 costs ~0.15× of it, and pays off (1.3×, one thread) only from level 4 on, because the
+///    singular correction and the mid blocks (~60 elements per target at radius 4) are a fixed cost.
 ///  - Singular part: for each target node and each element containing it, the regular-rule contribution of
 ///    that element is subtracted and replaced by a Duffy (collapsed-square) integral with the node at the
 ///    apex on the exact P2 geometry: one sub-triangle for a corner node; for a mid-side node the two halves
@@ -32,12 +48,14 @@
 ///  - Cached from the constructor (depends only on connectivity and Options): element → nodes, node →
 ///    (element, local index) incidence, mirror map, the rule's shape functions and derivatives, the Duffy
 ///    points of each of the 6 local node positions with their shape functions, derivatives and weights,
-///    the near-singular neighbour lists and the subdivided rule.
+///    the near-singular neighbour lists and the subdivided rule, and the coarse and "regular − coarse" rules
+///    of the far-field tier. Element centroids, radii and the centroid grid are rebuilt by every apply().
 ///  - The mesh connectivity (elements, node_element CSR, mirror_node, node count) must not change after
 ///    construction; the mesh object itself need not outlive the SingleLayer (connectivity is copied).
 ///  - Positions and loads may change freely between calls (nothing geometric is cached between calls).
-///  - apply() reuses internal work arrays: one SingleLayer must not be used by two threads at once. It is
-///    internally OpenMP-parallel.
+///  - apply() reuses internal work arrays (including per-thread scratch of the far-field tier): one
+///    SingleLayer must not be used by two threads at once. It is internally OpenMP-parallel.
+///  - far_degree = 0 gives bit for bit the result of the operator without the far-field tier.
 
 #include <vector>
 
@@ -67,6 +85,10 @@ struct SingleLayerOptions {
   /// (0 = off). Without it the error at mid-side nodes (h/2 from such elements) is O(h).
   int near_subdivision = 1;
   int near_degree = 6;         ///< rule of the near-singular sub-triangles: 4, 5 or 6
+  /// Far-field tier (see the file comment): 0 = off (every element gets the regular rule for every target),
+  /// 1 = centroid rule, 2 = 3-point degree-2 rule on elements farther than far_radius · ρ_e from the target.
+  int far_degree = 0;
+  double far_radius = 4.0;     ///< far when |x0 − c_e| > far_radius · ρ_e; must be > 1
   Symmetry symmetry = Symmetry::Auto;
   double symmetry_tol = 1e-10; ///< relative tolerance of the symmetry check
   KernelChoice kernel = KernelChoice::Fast;
@@ -77,17 +99,20 @@ struct SingleLayerOptions {
 struct SingleLayerStats {
   bool used_symmetry = false;  ///< whether only half of the targets were evaluated
   int targets = 0;             ///< number of targets evaluated
-  int sources = 0;             ///< quadrature points (unpadded)
+  int sources = 0;             ///< quadrature points of the all-pairs sum (unpadded; coarse rule if far on)
   double build_s = 0.0;        ///< laying out the quadrature points (SoA)
   double regular_s = 0.0;      ///< regular Stokeslet sum
   double singular_s = 0.0;     ///< singular and near-singular corrections (including their point layout)
+  double far_s = 0.0;          ///< far-field tier: centroid grid and "regular − coarse" blocks (0 when off)
+  long long mid_elements = 0;  ///< Σ over targets of the elements given the regular rule (0 when off)
   double total_s = 0.0;
 };
 
 /// @brief u(x0) = ∫_S J(x0, x)·q(x) dS(x) at every node (see the file comment).
 class SingleLayer {
  public:
-  /// @throws std::invalid_argument for an unknown rule degree or duffy_order < 1, or an inconsistent mesh.
+  /// @throws std::invalid_argument for an unknown rule degree, duffy_order < 1, far_degree ∉ {0, 1, 2},
+  /// far_radius ≤ 1, or an inconsistent mesh.
   explicit SingleLayer(const mesh::SurfaceMesh& mesh, const SingleLayerOptions& options = {});
 
   /// @brief u at every node; x and q are 3 × num_nodes. u is resized as needed.
@@ -118,8 +143,13 @@ class SingleLayer {
   static void layout(const std::vector<ShapeAt>& rule, const std::vector<std::array<int, 6>>& elements,
                      const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, AlignedVector& px, AlignedVector& py,
                      AlignedVector& pz, AlignedVector& pqx, AlignedVector& pqy, AlignedVector& pqz, int width);
+  // reg = SoA (x, y, z, qx, qy, qz) holding each element's regular-rule points at [s·stride, s·stride + nq),
+  // s = slot[e] (or e if slot is null).
   void singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, const std::vector<int>& targets,
-                           Eigen::Matrix3Xd& u) const;
+                           const double* const reg[6], int stride, const int* slot, Eigen::Matrix3Xd& u) const;
+  // Far-field tier: centroids, radii and grid of the current x, then the per-target mid blocks into u.
+  void build_centroid_grid(const Eigen::Matrix3Xd& x);
+  long long mid_correction(const std::vector<int>& targets, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& u);
 
   SingleLayerOptions opt_;
   int num_nodes_ = 0;
@@ -139,10 +169,24 @@ class SingleLayer {
   ShapeTable duffy_soa_[6];
   std::vector<ShapeAt> near_rule_;          // subdivided rule, then the regular rule negated (empty if off)
   std::vector<int> near_offsets_, near_elements_;  // node → near-singular elements CSR
+  std::vector<ShapeAt> coarse_;             // far-field rule (empty if off)
+  std::vector<ShapeAt> mid_rule_;           // regular rule, then the coarse rule negated (empty if off)
   // Work arrays (SoA sources, targets, results).
   AlignedVector sx_, sy_, sz_, sqx_, sqy_, sqz_;
   AlignedVector nx_, ny_, nz_, nqx_, nqy_, nqz_;  // near-rule points, element-major
   AlignedVector tx_, ty_, tz_, ux_, uy_, uz_;
+  AlignedVector mx_, my_, mz_, mqx_, mqy_, mqz_;  // mid-rule points, block per element in slot order (far tier)
+  // Far tier geometry of the current call: element centroids and radii, uniform grid (cell → elements CSR;
+  // slot j = position in cell order, element cell_elements_[j]), and per slot: element, centroid and
+  // (far_radius · ρ)².
+  std::vector<double> cx_, cy_, cz_, rho_;
+  std::vector<int> cell_offsets_, cell_elements_, cell_cursor_, cell_fill_, slot_;
+  std::vector<std::array<int, 6>> sorted_elements_;
+  std::vector<double> scx_, scy_, scz_, sreach2_;
+  double grid_lo_[3] = {0, 0, 0}, grid_cell_ = 1.0, far_reach_ = 0.0;
+  int grid_dim_[3] = {1, 1, 1};
+  std::vector<std::vector<int>> mark_;      // per-thread "already added for this target" stamps (per slot)
+  std::vector<std::vector<int>> slots_;     // per-thread mid slots of the current target
   std::vector<int> target_ids_;
   SingleLayerStats stats_;
 };

@@ -41,9 +41,11 @@ TEST_P(TriangleRuleExactness, ExactUpToDegreeNotBeyond) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Rules, TriangleRuleExactness,
-                         ::testing::Values(std::pair{4, 6}, std::pair{5, 7}, std::pair{6, 12}));
+                         ::testing::Values(std::pair{1, 1}, std::pair{2, 3}, std::pair{4, 6}, std::pair{5, 7},
+                                           std::pair{6, 12}));
 
 TEST(TriangleRule, UnknownDegreeThrows) {
+  EXPECT_THROW(triangle_rule(0), std::invalid_argument);
   EXPECT_THROW(triangle_rule(3), std::invalid_argument);
   EXPECT_THROW(triangle_rule(7), std::invalid_argument);
 }

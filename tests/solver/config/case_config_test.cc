@@ -1,0 +1,60 @@
+// Case configuration: the far-field keys of the boundary integral (parsing, ranges, echo).
+#include "solver/config/case_config.h"
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace capsim::config {
+namespace {
+
+TEST(CaseConfig, FarFieldKeysDefaultToOff) {
+  const CaseConfig c = parse_case_config("", "empty");
+  EXPECT_EQ(c.far_degree, 0);
+  EXPECT_EQ(c.far_radius, 4.0);
+  const auto map = c.to_map();
+  EXPECT_EQ(map.at("numerics.far_degree"), "0");
+  EXPECT_EQ(map.at("numerics.far_radius"), "4.0");
+  const std::string toml = c.to_toml();
+  EXPECT_NE(toml.find("far_degree = 0\n"), std::string::npos) << toml;
+  EXPECT_NE(toml.find("far_radius = 4.0\n"), std::string::npos) << toml;
+}
+
+TEST(CaseConfig, FarFieldKeysParseFromFileAndOverrides) {
+  CaseConfig c = parse_case_config("[numerics]\nfar_degree = 2\nfar_radius = 6\n", "case.toml");
+  EXPECT_EQ(c.far_degree, 2);
+  EXPECT_EQ(c.far_radius, 6.0);
+  c = parse_case_config("", "case.toml", {"numerics.far_degree=1", "numerics.far_radius=2.5"});
+  EXPECT_EQ(c.far_degree, 1);
+  EXPECT_EQ(c.far_radius, 2.5);
+  // The echoed TOML reads back to the same configuration.
+  EXPECT_EQ(parse_case_config(c.to_toml(), "echo").to_map(), c.to_map());
+}
+
+TEST(CaseConfig, FarFieldKeysAreRangeChecked) {
+  auto message = [](const std::vector<std::string>& overrides) {
+    try {
+      (void)parse_case_config("", "case.toml", overrides);
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  for (const char* bad : {"numerics.far_degree=3", "numerics.far_degree=-1"})
+    EXPECT_NE(message({bad}).find("numerics.far_degree"), std::string::npos) << bad;
+  for (const char* bad : {"numerics.far_radius=1.0", "numerics.far_radius=0.5", "numerics.far_radius=nan"})
+    EXPECT_NE(message({bad}).find("numerics.far_radius"), std::string::npos) << bad;
+  EXPECT_NE(message({"numerics.far_degree=1.5"}).find("expected an integer"), std::string::npos);
+  EXPECT_EQ(message({"numerics.far_degree=2", "numerics.far_radius=1.01"}), "");
+}
+
+TEST(CaseConfig, FarFieldKeysAreListed) {
+  const auto names = case_key_names();
+  EXPECT_NE(std::find(names.begin(), names.end(), "numerics.far_degree"), names.end());
+  EXPECT_NE(std::find(names.begin(), names.end(), "numerics.far_radius"), names.end());
+}
+
+}  // namespace
+}  // namespace capsim::config

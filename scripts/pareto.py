@@ -1,7 +1,7 @@
 """Run time against error for the two reference problems of issue 6 (see scripts/pareto).
 
-(a) sphere, Skalak C = 1, Ca = 0.3: the steady Taylor parameter D12 (value at γ̇t = 6, where the sphere
-    has reached its steady tank-treading shape: |dD12/dt| < 1e-4 there at every level);
+(a) sphere, Skalak C = 1, Ca = 0.3: the steady Taylor parameter D12 (interpolated at γ̇t = 5.9; the table
+    gives the remaining drift |dD12/dt| over γ̇t ∈ [5, 5.9], which bounds how far from steady it still is);
 (b) a/b = 2, Skalak C = 1, Ca = 0.3: the first minimum of D12 (parabola through the three lowest samples).
 Each variant changes one numerical knob from the default (level, time.dt_accuracy of RKC, the rk2 scheme,
 numerics.regular_degree, numerics.far_degree); the error is measured against the finest run of the study
@@ -50,7 +50,9 @@ def metric(case_file, kind):
         t = f["timeseries/t"][:]
         d = f["timeseries/D12"][:]
     if kind == "steady_D12":
-        return float(d[-1]), float(t[-1])
+        t_eval = 5.9
+        slope = (np.interp(t_eval, t, d) - np.interp(5.0, t, d)) / (t_eval - 5.0)
+        return float(np.interp(t_eval, t, d)), float(abs(slope))
     mask = t >= 1.0
     t, d = t[mask], d[mask]
     i = int(np.argmin(d))
@@ -68,6 +70,7 @@ def main():
     ap.add_argument("--far", action="store_true", help="include the distance-adaptive quadrature variants")
     ap.add_argument("--capsim", default=os.path.join(HERE, "build", "bin", "capsim"))
     ap.add_argument("--out", default=os.path.join(HERE, "results", "pareto"))
+    ap.add_argument("--fig-dir", default=os.path.join(HERE, "results", "figures"))
     ap.add_argument("--runs", default=None, help="where the case folders go (default: OUT/runs, not committed)")
     args = ap.parse_args()
     levels = [int(x) for x in args.levels.split(",")]
@@ -107,14 +110,15 @@ def main():
         for r in rows:
             r["front"] = not any(o is not r and o["wall_s"] <= r["wall_s"] and o["error"] < r["error"] for o in rows
                                  if o is not ref) and r is not ref
+        col = "drift dD12/dt" if st["metric"] == "steady_D12" else "at γ̇t"
         md += [f"## {st['title']}", "",
-               f"Reference: {ref['variant']} = {ref['metric']:.6f} (at γ̇t = {ref['metric_t']:.3f}), "
+               f"Reference: {ref['variant']} = {ref['metric']:.6f} ({col}: {ref['metric_t']:.3g}), "
                f"{ref['flow_evaluations']} evaluations, {ref['wall_s']:.0f} s on {ref['threads']} threads.", "",
-               "| variant | evaluations | wall s | metric | at γ̇t | error vs reference | on the front |",
+               f"| variant | evaluations | wall s | metric | {col} | error vs reference | on the front |",
                "|---|---|---|---|---|---|---|"]
         for r in sorted(rows, key=lambda r: r["wall_s"]):
             md.append(f"| {r['variant']} | {r['flow_evaluations']} | {r['wall_s']:.1f} | {r['metric']:.6f} | "
-                      f"{r['metric_t']:.3f} | {r['error']:.2e} | {'yes' if r['front'] else ''} |")
+                      f"{r['metric_t']:.3g} | {r['error']:.2e} | {'yes' if r['front'] else ''} |")
         md.append("")
         figs.append((name, st, rows, ref))
     with open(os.path.join(args.out, "pareto.md"), "w") as f:
@@ -124,7 +128,7 @@ def main():
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig_dir = os.path.join(HERE, "results", "figures")
+    fig_dir = args.fig_dir
     os.makedirs(fig_dir, exist_ok=True)
     for name, st, rows, ref in figs:
         fig, ax = plt.subplots(figsize=(6.4, 4.6))

@@ -422,26 +422,16 @@ long long SingleLayer::mid_correction(const std::vector<int>& targets, const Eig
         }
       total += nc;
       std::sort(mid, mid + nc);
-      double ax = 0.0, ay = 0.0, az = 0.0;
-      for (int c = 0; c < nc;) {
+      double acc[3] = {0.0, 0.0, 0.0};
+      for (int c = 0; c < nc;) {  // runs of consecutive mid elements are one contiguous block
         int d = c + 1;
         while (d < nc && mid[d] == mid[d - 1] + 1) ++d;
-        const int pb = mid[c] * nm, pe = (mid[d - 1] + 1) * nm;
+        add_block(x0, mx, my, mz, mqx, mqy, mqz, mid[c] * nm, (mid[d - 1] + 1) * nm, 1.0, acc);
         c = d;
-#pragma omp simd reduction(+ : ax, ay, az)
-        for (int p = pb; p < pe; ++p) {
-          const double dx = x0[0] - mx[p], dy = x0[1] - my[p], dz = x0[2] - mz[p];
-          const double r2 = dx * dx + dy * dy + dz * dz;
-          const double inv = r2 == 0.0 ? 0.0 : kernel::rsqrt_arith(r2);
-          const double sc = (dx * mqx[p] + dy * mqy[p] + dz * mqz[p]) * inv * inv * inv;
-          ax += mqx[p] * inv + dx * sc;
-          ay += mqy[p] * inv + dy * sc;
-          az += mqz[p] * inv + dz * sc;
-        }
       }
-      u(0, i) += ax;
-      u(1, i) += ay;
-      u(2, i) += az;
+      u(0, i) += acc[0];
+      u(1, i) += acc[1];
+      u(2, i) += acc[2];
     }
   }
   return total;

@@ -39,6 +39,17 @@ std::string law_label(const std::string& law, double C) {
   return law;
 }
 
+// A sampled capillary number as it was sampled (0.175 stays 0.175, 0.2 prints as 0.2): "%.2f" would round
+// the adaptive refinements' edges onto the coarse grid.
+std::string sampled(const SqlValue& v) {
+  if (auto* d = std::get_if<double>(&v)) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", *d);
+    return buf;
+  }
+  return "–";
+}
+
 std::string fixed2(const SqlValue& v) {
   if (auto* d = std::get_if<double>(&v)) {
     char buf[32];
@@ -111,7 +122,7 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
         h += " |";
         continue;
       }
-      star += std::holds_alternative<double>(r->lo) ? " Ca* ∈ [" + fixed2(r->lo) + ", " + fixed2(r->hi) + "] |"
+      star += std::holds_alternative<double>(r->lo) ? " Ca* ∈ [" + sampled(r->lo) + ", " + sampled(r->hi) + "] |"
                                                     : " Ca* not found |";
       h += std::holds_alternative<double>(r->h) ? " CaH = " + fixed2(r->h) + " |" : " CaH not bracketed |";
     }

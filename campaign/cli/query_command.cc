@@ -39,25 +39,21 @@ std::string law_label(const std::string& law, double C) {
   return law;
 }
 
-// A sampled capillary number as it was sampled (0.175 stays 0.175, 0.2 prints as 0.2): "%.2f" would round
-// the adaptive refinements' edges onto the coarse grid.
-std::string sampled(const SqlValue& v) {
+// A number of the table, or "–" for NULL.
+std::string format_value(const SqlValue& v, const char* format) {
   if (auto* d = std::get_if<double>(&v)) {
     char buf[32];
-    std::snprintf(buf, sizeof buf, "%.6g", *d);
+    std::snprintf(buf, sizeof buf, format, *d);
     return buf;
   }
   return "–";
 }
 
-std::string fixed2(const SqlValue& v) {
-  if (auto* d = std::get_if<double>(&v)) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.2f", *d);
-    return buf;
-  }
-  return "–";
-}
+// A sampled capillary number as it was sampled (0.175 stays 0.175, 0.2 prints as 0.2): "%.2f" would round
+// the adaptive refinements' edges onto the coarse grid.
+std::string sampled(const SqlValue& v) { return format_value(v, "%.6g"); }
+
+std::string fixed2(const SqlValue& v) { return format_value(v, "%.2f"); }
 
 int table1(campaign::Store& store, const std::string& name, campaign::Format fmt, int mesh_level, double skalak_C) {
   const std::string camp = resolve_campaign(store, name);

@@ -45,13 +45,13 @@ void write_snapshot(io::CaseWriter& writer, dynamics::CapsuleFlow& flow, const E
   writer.write_snapshot(t, step, flow.mesh(), x, fields);
 }
 
-// Wrinkle indicators of state x (one extra flow evaluation for the load). A state the membrane rejects
-// (collapsed element) has none.
+// Wrinkle indicators of state x (membrane and load only: no boundary integral, no flow evaluation counted).
+// A state the membrane rejects (collapsed element) has none.
 std::optional<diagnostics::WrinkleIndicators> measure_wrinkle(dynamics::CapsuleFlow& flow, const Eigen::Matrix3Xd& x,
                                                               int membrane_degree) {
   try {
-    Eigen::Matrix3Xd v, q;
-    flow.velocity(x, v, &q);
+    Eigen::Matrix3Xd q;
+    flow.membrane_load(x, q);
     diagnostics::WrinkleIndicators w;
     w.compressed_area_fraction = diagnostics::compressed_area_fraction(
         flow.mesh(), x, flow.mechanics().principal_tensions(x), membrane_degree);
@@ -63,7 +63,7 @@ std::optional<diagnostics::WrinkleIndicators> measure_wrinkle(dynamics::CapsuleF
 }
 
 // Wrinkle indicators are sampled on this fixed time grid (units of 1/γ̇): often enough to catch a
-// transient, rare enough to cost < 1% of the flow evaluations.
+// transient; each sample costs one membrane evaluation and load solve (O(N), no boundary integral).
 constexpr double kWrinkleInterval = 1.0;
 
 }  // namespace

@@ -41,23 +41,27 @@ CapsuleFlow::CapsuleFlow(const config::CaseConfig& c) : Ca_(c.capillary_number) 
 
 CapsuleFlow::~CapsuleFlow() = default;
 
-FlowEvaluation CapsuleFlow::velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, Eigen::Matrix3Xd* load) {
-  FlowEvaluation out;
+membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q) {
   auto t0 = std::chrono::steady_clock::now();
-  const membrane::MembraneState s = mechanics_->evaluate(x);
+  membrane::MembraneState s = mechanics_->evaluate(x);
   timings_.membrane_s += seconds_since(t0);
-  out.tau_min = s.tau_min;
-  out.tau_max = s.tau_max;
-
   t0 = std::chrono::steady_clock::now();
   try {
-    load_solver_->compute_load(x, s.internal_force, q_);
+    load_solver_->compute_load(x, s.internal_force, q);
   } catch (const std::runtime_error& e) {
     throw membrane::DegenerateSurface(e.what());
   }
   timings_.load_s += seconds_since(t0);
+  return s;
+}
 
-  t0 = std::chrono::steady_clock::now();
+FlowEvaluation CapsuleFlow::velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, Eigen::Matrix3Xd* load) {
+  FlowEvaluation out;
+  const membrane::MembraneState s = membrane_load(x, q_);
+  out.tau_min = s.tau_min;
+  out.tau_max = s.tau_max;
+
+  auto t0 = std::chrono::steady_clock::now();
   single_layer_->apply(x, q_, u_);
   timings_.stokes_s += seconds_since(t0);
   out.used_symmetry = single_layer_->last_stats().used_symmetry;

@@ -56,6 +56,11 @@ class CapsuleFlow {
   /// @brief v on positions x (3 × N). Also fills q (the membrane load) when asked.
   /// @throws membrane::DegenerateSurface if x has a collapsed element (a blow-up).
   FlowEvaluation velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, Eigen::Matrix3Xd* load = nullptr);
+  /// @brief The membrane load q on positions x alone (membrane + load solve, no boundary integral): for
+  /// diagnostics that need q but not v. Not counted as a flow evaluation; its time goes to the membrane and
+  /// load phases. Returns the membrane state (tensions, forces).
+  /// @throws membrane::DegenerateSurface if x has a collapsed element.
+  membrane::MembraneState membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q);
 
   [[nodiscard]] const mesh::SurfaceMesh& mesh() const { return *mesh_; }
   [[nodiscard]] const Eigen::Matrix3Xd& reference() const { return mesh_->nodes; }

@@ -258,7 +258,12 @@ void SingleLayer::layout(const std::vector<ShapeAt>& rule, const std::vector<std
 }
 
 kernel::Sources SingleLayer::build_sources(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) {
-  layout(regular_, elements_, x, q, sx_, sy_, sz_, sqx_, sqy_, sqz_, kernel::simd_width());
+  return layout_sources(regular_, x, q);
+}
+
+kernel::Sources SingleLayer::layout_sources(const std::vector<ShapeAt>& rule, const Eigen::Matrix3Xd& x,
+                                            const Eigen::Matrix3Xd& q) {
+  layout(rule, elements_, x, q, sx_, sy_, sz_, sqx_, sqy_, sqz_, kernel::simd_width());
   return {sx_.data(), sy_.data(), sz_.data(), sqx_.data(), sqy_.data(), sqz_.data(), static_cast<int>(sx_.size())};
 }
 
@@ -528,13 +533,7 @@ void SingleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Ei
 
   // With the far-field tier the all-pairs sum runs over the coarse rule; without it, over the regular rule.
   const bool far = opt_.far_degree > 0;
-  kernel::Sources src;
-  if (far) {
-    layout(coarse_, elements_, x, q, sx_, sy_, sz_, sqx_, sqy_, sqz_, kernel::simd_width());
-    src = {sx_.data(), sy_.data(), sz_.data(), sqx_.data(), sqy_.data(), sqz_.data(), static_cast<int>(sx_.size())};
-  } else {
-    src = build_sources(x, q);
-  }
+  const kernel::Sources src = layout_sources(far ? coarse_ : regular_, x, q);
   const double t1 = now_s();
 
   // Targets: all nodes, or one of each mirror pair (the one with the larger x3; a node on the plane is its

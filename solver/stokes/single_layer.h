@@ -145,6 +145,8 @@ class SingleLayer {
                      AlignedVector& pz, AlignedVector& pqx, AlignedVector& pqy, AlignedVector& pqz, int width);
   // reg = SoA (x, y, z, qx, qy, qz) holding each element's regular-rule points at [s·stride, s·stride + nq),
   // s = slot[e] (or e if slot is null).
+  // Lays out the points of `rule` on every element as the padded SoA sources of the all-pairs sum.
+  kernel::Sources layout_sources(const std::vector<ShapeAt>& rule, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q);
   void singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, const std::vector<int>& targets,
                            const double* const reg[6], int stride, const int* slot, Eigen::Matrix3Xd& u) const;
   // Far-field tier: centroids, radii and grid of the current x, then the per-target mid blocks into u.

@@ -24,13 +24,6 @@ std::string slurm_unavailable() {
   return "";
 }
 
-std::string sql(const std::string& db, const std::string& q) {
-  auto r = sh(exe() + " query sql \"" + q + "\" --db " + db + " --format csv");
-  EXPECT_EQ(r.code, 0) << q << ": " << r.err;
-  auto nl = r.out.find('\n');
-  return nl == std::string::npos ? "" : r.out.substr(nl + 1);
-}
-
 std::string job_of(const std::string& submit_out) {
   std::smatch m;
   if (std::regex_search(submit_out, m, std::regex(R"(submitted job (\d+))"))) return m[1];

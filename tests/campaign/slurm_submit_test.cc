@@ -46,13 +46,6 @@ struct FakeSlurm {
   std::string script(int job) const { return dir + "/submitted-" + std::to_string(job) + ".sh"; }
 };
 
-std::string sql(const std::string& db, const std::string& q) {
-  auto r = sh(exe() + " query sql \"" + q + "\" --db " + db + " --format csv");
-  EXPECT_EQ(r.code, 0) << q << ": " << r.err;
-  auto nl = r.out.find('\n');
-  return nl == std::string::npos ? "" : r.out.substr(nl + 1);
-}
-
 /// Everything the database holds, as text (for "run twice = same database").
 std::string dump(const std::string& db) {
   std::string all;

@@ -14,6 +14,8 @@
 #include <thread>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 namespace capsim::campaign::testing {
 
 namespace fs = std::filesystem;
@@ -61,6 +63,14 @@ inline CmdResult sh(const std::string& cmd) {
   fs::remove(base + ".out");
   fs::remove(base + ".err");
   return r;
+}
+
+/// The rows of `capsim query sql Q --db DB --format csv`, without the header line; the query must succeed.
+inline std::string sql(const std::string& db, const std::string& q) {
+  auto r = sh(exe() + " query sql \"" + q + "\" --db " + db + " --format csv");
+  EXPECT_EQ(r.code, 0) << q << ": " << r.err;
+  auto nl = r.out.find('\n');
+  return nl == std::string::npos ? "" : r.out.substr(nl + 1);
 }
 
 /// Starts a shell command in the background; returns the pid of the exec'd program.

@@ -16,12 +16,14 @@ double compressed_area_fraction(const mesh::SurfaceMesh& mesh, const Eigen::Matr
   if (static_cast<long>(tensions.size()) != static_cast<long>(ne) * nq)
     throw std::invalid_argument("compressed_area_fraction: expected one tension pair per quadrature point");
   if (x.cols() != mesh.num_nodes()) throw std::invalid_argument("compressed_area_fraction: x has the wrong size");
+  std::vector<std::array<std::array<double, 6>, 2>> grad(static_cast<std::size_t>(nq));
+  for (int k = 0; k < nq; ++k) grad[k] = mesh::p2_shape_gradients(rule.points[k][1], rule.points[k][2]);
   double total = 0, compressed = 0;
   for (int e = 0; e < ne; ++e) {
     const auto& el = mesh.elements[e];
     for (int k = 0; k < nq; ++k) {
       // Current area element |∂x/∂ξ × ∂x/∂η| on the exact P2 geometry.
-      const auto g = mesh::p2_shape_gradients(rule.points[k][1], rule.points[k][2]);
+      const auto& g = grad[k];
       Eigen::Vector3d t1 = Eigen::Vector3d::Zero(), t2 = Eigen::Vector3d::Zero();
       for (int a = 0; a < 6; ++a) {
         t1 += g[0][a] * x.col(el[a]);

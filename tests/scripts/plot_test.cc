@@ -50,6 +50,7 @@ Cmd sh(const std::string& cmd) {
 std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
 std::string plot() { return kPython + " " + q(fs::path(kSrc) / "scripts" / "plot"); }
 std::string table1() { return kPython + " " + q(fs::path(kSrc) / "scripts" / "table1"); }
+std::string mesh_check() { return kPython + " " + q(fs::path(kSrc) / "scripts" / "mesh_check"); }
 
 bool is_png(const fs::path& p) {
   const std::string s = slurp(p);
@@ -170,6 +171,32 @@ TEST_F(ScriptsTest, MissingInputsExitTwoWithOneMessage) {
   EXPECT_EQ(count_lines(r.err), 1) << r.err;
   const Cmd r2 = sh(plot() + " --case " + q(junk));
   EXPECT_EQ(r2.code, 2) << r2.err;
+}
+
+TEST_F(ScriptsTest, MeshCheckComparesRunsOverOneWindow) {
+  const auto h5 = dir_ / "case" / "case.h5";
+  // The same file twice: identical rows. The fixture run stops at t = 3 without a period, so the window
+  // is given; it must end at --t1 and be --period long.
+  const Cmd r = sh(mesh_check() + " A=" + q(h5) + " B=" + q(h5) + " --period 1 --t1 2.5");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("Common window: t in [1.50, 2.50] (period 1.00)"), std::string::npos) << r.out;
+  const auto row = [&](const std::string& label) {
+    const auto b = r.out.find("\n| " + label + " | ");
+    EXPECT_NE(b, std::string::npos) << r.out;
+    const auto e = r.out.find('\n', b + 1);
+    return r.out.substr(b + 4 + label.size(), e - b - 4 - label.size());
+  };
+  EXPECT_EQ(row("A"), row("B"));
+  EXPECT_NE(row("A").find("| 1 |"), std::string::npos) << "mesh level of the fixture (1) not shown: " << r.out;
+  EXPECT_NE(row("A").find("— / —"), std::string::npos) << "no period: the reported values are missing";
+  // Without a period in the file and none given, one clear message and exit code 2.
+  const Cmd no_period = sh(mesh_check() + " A=" + q(h5));
+  EXPECT_EQ(no_period.code, 2) << no_period.err;
+  EXPECT_NE(no_period.err.find("--period"), std::string::npos) << no_period.err;
+  for (const std::string& bad : {" A=" + q(dir_ / "does-not-exist.h5"), std::string(" just-a-path.h5")}) {
+    const Cmd b = sh(mesh_check() + bad + " --period 1");
+    EXPECT_EQ(b.code, 2) << bad << "\n" << b.err;
+  }
 }
 
 TEST(SeedTable1, HoldsTheSeedValues) {

@@ -189,6 +189,19 @@ TEST_F(ScriptsTest, MeshCheckComparesRunsOverOneWindow) {
   EXPECT_EQ(row("A"), row("B"));
   EXPECT_NE(row("A").find("| 1 |"), std::string::npos) << "mesh level of the fixture (1) not shown: " << r.out;
   EXPECT_NE(row("A").find("— / —"), std::string::npos) << "no period: the reported values are missing";
+  // The window values, computed here independently from the raw series: min D12 and max τmin over
+  // [1.5, 2.5], then max τmin over [0.5, 1.5] (the k = 2 window).
+  const Cmd ref = sh(kPython + " -c \"import h5py, numpy as np; f = h5py.File('" + h5.string() +
+                     "', 'r'); t = f['timeseries/t'][:]; d = f['timeseries/D12'][:]; m = f['timeseries/tau_min'][:];"
+                     " w = (t >= 1.5) & (t <= 2.5); v = (t >= 0.5) & (t <= 1.5);"
+                     " print('| %.4f | %+.4f |' % (d[w].min(), m[w].max())); print('| %+.4f, %+.4f |' % (m[w].max(), m[v].max()))\"");
+  ASSERT_EQ(ref.code, 0) << ref.err;
+  const auto nl = ref.out.find('\n');
+  ASSERT_NE(nl, std::string::npos) << ref.out;
+  const std::string window_cells = ref.out.substr(0, nl);                                   // "| D12 | τ |"
+  const std::string per_window = ref.out.substr(nl + 1, ref.out.find('\n', nl + 1) - nl - 1);  // "| τ1, τ2 |"
+  EXPECT_NE(row("A").find(window_cells), std::string::npos) << window_cells << " not in\n" << r.out;
+  EXPECT_NE(row("A").find(per_window), std::string::npos) << per_window << " not in\n" << r.out;
   // Without a period in the file and none given, one clear message and exit code 2.
   const Cmd no_period = sh(mesh_check() + " A=" + q(h5));
   EXPECT_EQ(no_period.code, 2) << no_period.err;

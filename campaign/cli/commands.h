@@ -21,6 +21,9 @@ int campaign_command(const std::vector<std::string>& args);
 /// @brief `capsim query table1|cases|sql ... --db FILE [--format md|csv|json]`.
 int query_command(const std::vector<std::string>& args);
 
+/// @brief `capsim keys --format md`: the case-key table of schemas/case_keys.md, from the registry.
+int keys_command(const std::vector<std::string>& args);
+
 /// @brief `capsim bench kernel [--json]`.
 int bench_command(const std::vector<std::string>& args);
 

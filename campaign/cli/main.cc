@@ -21,6 +21,7 @@ void print_usage() {
       "  capsim campaign status --db FILE\n"
       "  capsim query table1|cases|sql ... --db FILE [--format md|csv|json]\n"
       "  capsim bench kernel [--json]\n"
+      "  capsim keys --format md\n"
       "  capsim --version\n",
       capsim::kVersion, capsim::kGitCommit);
 }
@@ -47,6 +48,7 @@ int main(int argc, char** argv) {
     if (cmd == "campaign") return capsim::cli::campaign_command(rest);
     if (cmd == "query") return capsim::cli::query_command(rest);
     if (cmd == "bench") return capsim::cli::bench_command(rest);
+    if (cmd == "keys") return capsim::cli::keys_command(rest);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "capsim: error: %s\n", e.what());
     return 1;

@@ -11,6 +11,7 @@
 #include "campaign/common/bad_input.h"
 #include "campaign/grid/decimal.h"
 #include "solver/config/case_config.h"
+#include "solver/config/toml_value.h"
 
 namespace capsim::campaign {
 
@@ -20,48 +21,15 @@ namespace {
   throw BadInput(source + ": " + key + ": " + what);
 }
 
-std::string type_name(const toml::node& n) {
-  switch (n.type()) {
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a float";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::table: return "a table";
-    default: return "a date/time";
-  }
-}
+using config::toml_type_name;
 
-/// Converts a TOML scalar to a Value of the key's type, with range checks.
+/// Converts a TOML scalar to a Value of the key's type, checked against the key's registry range.
 Value to_value(const CaseKey& key, const toml::node& n, const std::string& source, const std::string& where) {
-  Value v;
-  switch (key.type) {
-    case KeyType::kFloat:
-      if (auto f = n.value_exact<double>()) v = *f;
-      else if (auto i = n.value_exact<std::int64_t>()) v = static_cast<double>(*i);
-      else fail(source, where, "expected a number, got " + type_name(n));
-      break;
-    case KeyType::kInt:
-      if (auto i = n.value_exact<std::int64_t>()) v = *i;
-      else fail(source, where, "expected an integer, got " + type_name(n));
-      break;
-    case KeyType::kString:
-      if (auto s = n.value_exact<std::string>()) v = *s;
-      else fail(source, where, "expected a string, got " + type_name(n));
-      break;
-    case KeyType::kBool:
-      if (auto b = n.value_exact<bool>()) v = *b;
-      else fail(source, where, "expected true or false, got " + type_name(n));
-      break;
-    case KeyType::kFloatOrAuto:
-      if (auto f = n.value_exact<double>()) v = *f;
-      else if (auto i = n.value_exact<std::int64_t>()) v = static_cast<double>(*i);
-      else if (auto s = n.value_exact<std::string>()) v = *s;
-      else fail(source, where, "expected \"auto\" or a number, got " + type_name(n));
-      break;
-  }
-  if (auto msg = check_case_value(key, v); !msg.empty()) fail(source, where, msg);
-  return v;
+  std::string why;
+  auto v = config::toml_to_key_value(key, n, why);
+  if (!v) fail(source, where, why);
+  if (auto msg = check_case_value(key, *v); !msg.empty()) fail(source, where, msg);
+  return *v;
 }
 
 /// Flattens [defaults] (nested tables or dotted keys) into dotted case keys.
@@ -114,7 +82,7 @@ std::vector<Value> read_axis(const CaseKey& key, const toml::node& node, const s
       double x;
       if (auto f = n->value_exact<double>()) x = *f;
       else if (auto iv = n->value_exact<std::int64_t>()) x = static_cast<double>(*iv);
-      else fail(source, where + "." + names[i], "expected a number, got " + type_name(*n));
+      else fail(source, where + "." + names[i], "expected a number, got " + toml_type_name(*n));
       try {
         bounds[i] = Decimal::from_double(x);
       } catch (const std::exception& e) {
@@ -139,7 +107,7 @@ std::vector<Value> read_axis(const CaseKey& key, const toml::node& node, const s
       push_unique(std::move(v));
     }
   } else {
-    fail(source, where, "expected a list of values or a {start, stop, step} table, got " + type_name(node));
+    fail(source, where, "expected a list of values or a {start, stop, step} table, got " + toml_type_name(node));
   }
   return values;
 }
@@ -175,7 +143,7 @@ CampaignSpec parse_campaign(const std::string& text, const std::string& source) 
   expect_only(ct, {"name", "description"}, source, "[campaign]");
   if (auto* n = ct.get("name")) {
     auto s = n->value_exact<std::string>();
-    if (!s) fail(source, "[campaign] name", "expected a string, got " + type_name(*n));
+    if (!s) fail(source, "[campaign] name", "expected a string, got " + toml_type_name(*n));
     if (s->empty()) fail(source, "[campaign] name", "must not be empty");
     spec.name = *s;
   } else {
@@ -183,7 +151,7 @@ CampaignSpec parse_campaign(const std::string& text, const std::string& source) 
   }
   if (auto* n = ct.get("description")) {
     auto s = n->value_exact<std::string>();
-    if (!s) fail(source, "[campaign] description", "expected a string, got " + type_name(*n));
+    if (!s) fail(source, "[campaign] description", "expected a string, got " + toml_type_name(*n));
     spec.description = *s;
   }
 
@@ -221,9 +189,11 @@ CampaignSpec parse_campaign(const std::string& text, const std::string& source) 
         }
         continue;
       }
-      if (dotted.empty())
-        fail(source, where + "." + name,
-             "unknown grid axis (expected capillary_number, aspect_ratio, law, skalak_C, mesh_level or a case key)");
+      if (dotted.empty()) {
+        std::string aliases;
+        for (const auto& [alias, key] : axis_aliases()) aliases += alias + ", ";
+        fail(source, where + "." + name, "unknown grid axis (expected " + aliases + "or a case key)");
+      }
       if (!seen.insert(dotted).second) fail(source, where + "." + name, "axis given twice");
       block.axes.push_back({dotted, read_axis(*find_case_key(dotted), node, source, where + "." + name)});
     }
@@ -239,7 +209,7 @@ CampaignSpec parse_campaign(const std::string& text, const std::string& source) 
       if (auto* n = at.get(k)) {
         std::optional<double> x = n->value_exact<double>();
         if (!x) if (auto i = n->value_exact<std::int64_t>()) x = static_cast<double>(*i);
-        if (!x) fail(source, std::string("[analysis] ") + k, "expected a number, got " + type_name(*n));
+        if (!x) fail(source, std::string("[analysis] ") + k, "expected a number, got " + toml_type_name(*n));
         if (!(*x > lo && *x < hi))
           fail(source, std::string("[analysis] ") + k,
                "out of range (" + canonical_double(lo) + ", " + canonical_double(hi) + "): " + canonical_double(*x));
@@ -249,7 +219,7 @@ CampaignSpec parse_campaign(const std::string& text, const std::string& source) 
     auto integer = [&](const char* k, int& out, int lo, int hi) {
       if (auto* n = at.get(k)) {
         auto x = n->value_exact<std::int64_t>();
-        if (!x) fail(source, std::string("[analysis] ") + k, "expected an integer, got " + type_name(*n));
+        if (!x) fail(source, std::string("[analysis] ") + k, "expected an integer, got " + toml_type_name(*n));
         if (*x < lo || *x > hi)
           fail(source, std::string("[analysis] ") + k,
                "out of range " + std::to_string(lo) + ".." + std::to_string(hi) + ": " + std::to_string(*x));
@@ -262,7 +232,7 @@ CampaignSpec parse_campaign(const std::string& text, const std::string& source) 
     integer("max_rounds", spec.analysis.max_rounds, 1, 1000);
     if (auto* n = at.get("adaptive")) {
       auto b = n->value_exact<bool>();
-      if (!b) fail(source, "[analysis] adaptive", "expected true or false, got " + type_name(*n));
+      if (!b) fail(source, "[analysis] adaptive", "expected true or false, got " + toml_type_name(*n));
       spec.analysis.adaptive = *b;
     }
   }

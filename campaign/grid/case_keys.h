@@ -1,42 +1,38 @@
 #pragma once
 /// @file
-/// @brief The registry of case keys (`section.key`) a campaign may set, with types, defaults and checks.
-/// It mirrors the solver's case file (schemas/campaign_keys.md documents both); keep them in sync.
+/// @brief The case keys as the campaign sees them: the solver's key registry (solver/config/case_keys.h,
+/// entries in case_keys.def) under the campaign's names, plus what only the campaign has: the TOML text of
+/// a value in a case file and the short grid-axis aliases.
 
-#include <cstdint>
-#include <optional>
 #include <string>
-#include <variant>
+#include <string_view>
+#include <utility>
 #include <vector>
+
+#include "solver/config/case_keys.h"
 
 namespace capsim::campaign {
 
 /// @brief A case-key value: integer, floating point, string or boolean.
-using Value = std::variant<std::int64_t, double, std::string, bool>;
-
+using Value = config::KeyValue;
 /// @brief The type a case key accepts.
-enum class KeyType { kFloat, kInt, kString, kBool, kFloatOrAuto };
+using KeyType = config::KeyType;
+/// @brief One registry entry (name, type, default_value, rule, in_identity, always_stored, doc).
+using CaseKey = config::CaseKey;
 
-/// @brief One documented case key.
-struct CaseKey {
-  std::string name;              ///< dotted name, e.g. "flow.capillary_number"
-  KeyType type;                  ///< accepted type (integers are accepted for floats)
-  std::optional<Value> fallback; ///< default filled into every case (none: only present when set)
-  bool in_identity = true;       ///< false for keys that do not change results (output.*)
-  std::string doc;               ///< one-line description with the allowed range
-};
+// The registry's functions under the campaign's names (the same functions, so that calls found by
+// argument-dependent lookup are not ambiguous): case_keys(), find_case_key(name) and
+// check_case_value(key, value) ("" if the value has the key's type and lies in its range, else a message).
+using config::case_keys;
+using config::check_case_value;
+using config::find_case_key;
 
-/// @brief All case keys known to the campaign manager.
-const std::vector<CaseKey>& case_keys();
-
-/// @brief The key named @p name, or nullptr.
-const CaseKey* find_case_key(const std::string& name);
-
-/// @brief Checks range/enumeration constraints of @p value for @p key; returns "" or a message.
-std::string check_case_value(const CaseKey& key, const Value& value);
-
-/// @brief Text of a value as it appears in TOML and identities (strings quoted).
+/// @brief Text of a value as it appears in a campaign's case files (strings quoted and escaped, doubles in
+/// their shortest round-trip decimal).
 std::string value_to_text(const Value& v);
+
+/// @brief The grid-axis aliases, "alias -> dotted key", in the order messages list them.
+const std::vector<std::pair<std::string, std::string>>& axis_aliases();
 
 /// @brief Short grid-axis aliases: capillary_number, aspect_ratio, law, skalak_C, mesh_level.
 /// Returns the dotted key for an alias or a dotted key, or "" if unknown.

@@ -16,7 +16,7 @@ std::string solver_version() { return kSolverVersion; }
 CaseParams CaseParams::defaults() {
   CaseParams p;
   for (const auto& k : case_keys())
-    if (k.fallback) p.values_[k.name] = *k.fallback;
+    if (k.always_stored) p.values_[k.name] = k.default_value;
   return p;
 }
 
@@ -43,36 +43,38 @@ CaseParams CaseParams::from_json(const std::string& json_text) {
 }
 
 namespace {
-double num(const std::map<std::string, Value>& m, const std::string& k, double fallback) {
-  auto it = m.find(k);
-  if (it == m.end()) return fallback;
-  if (auto* d = std::get_if<double>(&it->second)) return *d;
-  if (auto* i = std::get_if<std::int64_t>(&it->second)) return static_cast<double>(*i);
-  return fallback;
+/// The value of @p key in @p m, or the registry's default when the case does not set it.
+const Value& value_or_default(const std::map<std::string, Value>& m, const std::string& key) {
+  auto it = m.find(key);
+  return it != m.end() ? it->second : find_case_key(key)->default_value;
+}
+double number(const std::map<std::string, Value>& m, const std::string& key) {
+  const Value& v = value_or_default(m, key);
+  if (auto* i = std::get_if<std::int64_t>(&v)) return static_cast<double>(*i);
+  return std::get<double>(v);
 }
 }  // namespace
 
-double CaseParams::capillary_number() const { return num(values_, "flow.capillary_number", 0.3); }
-double CaseParams::aspect_ratio() const { return num(values_, "capsule.aspect_ratio", 2.0); }
-double CaseParams::skalak_C() const { return num(values_, "capsule.skalak_C", 1.0); }
-int CaseParams::mesh_level() const { return static_cast<int>(num(values_, "mesh.level", 3)); }
-double CaseParams::t_end() const { return num(values_, "time.t_end", 60.0); }
-std::string CaseParams::law() const {
-  auto it = values_.find("capsule.law");
-  if (it == values_.end()) return "skalak";
-  return std::get<std::string>(it->second);
-}
+double CaseParams::capillary_number() const { return number(values_, "flow.capillary_number"); }
+double CaseParams::aspect_ratio() const { return number(values_, "capsule.aspect_ratio"); }
+double CaseParams::skalak_C() const { return number(values_, "capsule.skalak_C"); }
+int CaseParams::mesh_level() const { return static_cast<int>(number(values_, "mesh.level")); }
+double CaseParams::t_end() const { return number(values_, "time.t_end"); }
+std::string CaseParams::law() const { return std::get<std::string>(value_or_default(values_, "capsule.law")); }
 
 std::string CaseParams::canonical() const {
   // The solver resolves every default, so an explicit default and an unset key give the same identity,
   // and numbers are canonical however they were typed (2 and 2.0).
   const auto resolved = config::parse_case_config(to_toml(), "case " + to_json()).to_map();
-  const bool neo = law() == "neo-hookean";
   std::string out;
   for (const auto& [k, v] : resolved) {
     const CaseKey* key = find_case_key(k);
-    if (key && !key->in_identity) continue;
-    if (neo && k == "capsule.skalak_C") continue;
+    if (!key->in_identity) continue;
+    // Keys added after identities were first stored enter only when set otherwise, so that adding a key
+    // leaves every existing case its identity.
+    if (key->identity_omits_default && v == config::identity_text(key->default_value)) continue;
+    // A key the solver ignores for this case (skalak_C of a neo-Hookean capsule) must not split one case in two.
+    if (!key->unless_key.empty() && resolved.at(key->unless_key) == config::identity_text(key->unless_value)) continue;
     out += k + "=" + v + "\n";
   }
   return out;

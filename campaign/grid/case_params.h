@@ -41,9 +41,10 @@ class CaseParams {
   double t_end() const;
 
   /// @brief Canonical text of the parameters that change results: the solver's own resolved configuration
-  /// (capsim::config::CaseConfig::to_map(), every default explicit) as sorted "key=value" lines, output
-  /// keys that do not change results (snapshot/checkpoint intervals) left out, capsule.skalak_C left out for
-  /// the neo-Hookean law. @throws capsim::config::ConfigError if the solver rejects the case.
+  /// (capsim::config::CaseConfig::to_map(), defaults explicit) as sorted "key=value" lines, with what the
+  /// key registry (solver/config/case_keys.def) leaves out: output-only keys, keys ignored for this case
+  /// (capsule.skalak_C of the neo-Hookean law) and keys added later that are at their default.
+  /// @throws capsim::config::ConfigError if the solver rejects the case.
   std::string canonical() const;
   /// @brief Case identity: first 16 hex digits of SHA-256(canonical() + "solver=" + version).
   std::string identity(const std::string& version) const;

@@ -189,13 +189,22 @@ TEST(Grid, CaseTomlHasSections) {
 
 namespace capsim::campaign {
 namespace {
-// The campaign's key table mirrors the solver's: a key added to one and not the other would make campaigns
-// reject valid case keys or pass unknown ones to the solver.
-TEST(CaseKeys, SameSetAsTheSolver) {
-  std::set<std::string> campaign_side, solver_side;
-  for (const auto& k : case_keys()) campaign_side.insert(k.name);
-  for (const auto& k : config::case_key_names()) solver_side.insert(k);
-  EXPECT_EQ(campaign_side, solver_side);
+// The campaign's defaults are the registry's: a case that sets nothing reads the solver's defaults, and
+// the keys stored in every case are exactly those the registry marks always_stored.
+TEST(CaseKeys, CampaignDefaultsAreTheRegistrys) {
+  const CaseParams p = CaseParams::defaults();
+  const config::CaseConfig solver;
+  EXPECT_EQ(p.capillary_number(), solver.capillary_number);
+  EXPECT_EQ(p.aspect_ratio(), solver.aspect_ratio);
+  EXPECT_EQ(p.skalak_C(), solver.skalak_C);
+  EXPECT_EQ(p.law(), solver.law);
+  EXPECT_EQ(p.mesh_level(), solver.level);
+  EXPECT_EQ(p.t_end(), solver.t_end);
+  for (const auto& k : case_keys()) EXPECT_EQ(p.values().count(k.name) == 1, k.always_stored) << k.name;
+  // An empty case (nothing stored at all) falls back to the same defaults.
+  const CaseParams empty = CaseParams::from_json("{}");
+  EXPECT_EQ(empty.capillary_number(), solver.capillary_number);
+  EXPECT_EQ(empty.mesh_level(), solver.level);
 }
 }  // namespace
 }  // namespace capsim::campaign

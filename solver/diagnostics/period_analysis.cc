@@ -23,25 +23,38 @@ double refined_time(std::span<const double> t, std::span<const double> y, std::s
   return std::clamp(t1 - 0.5 * num / den, t0, t2);
 }
 
+// An axis inclination (defined modulo π) brought into (−π/2, π/2].
+double wrap_axis_angle(double a) {
+  double w = std::remainder(a, kPi);
+  if (w <= -0.5 * kPi) w += kPi;
+  return w;
+}
+
 // Statistics of the samples [i0, i1] (time bounds tb, te already set in w).
 void fill_window(PeriodWindow& w, std::span<const double> t, std::span<const double> D12,
                  std::span<const double> theta_u, std::span<const double> tau_min) {
   const std::size_t i0 = w.i_begin, i1 = w.i_end;
   w.min_D12 = *std::min_element(D12.begin() + i0, D12.begin() + i1 + 1);
   w.max_D12 = *std::max_element(D12.begin() + i0, D12.begin() + i1 + 1);
-  w.max_tau_min = *std::max_element(tau_min.begin() + i0, tau_min.begin() + i1 + 1);
+  const auto [tau_lo, tau_hi] = std::minmax_element(tau_min.begin() + i0, tau_min.begin() + i1 + 1);
+  w.max_tau_min = *tau_hi;
+  w.min_tau_min = *tau_lo;
   const auto [th_lo, th_hi] = std::minmax_element(theta_u.begin() + i0, theta_u.begin() + i1 + 1);
   w.theta_amplitude = 0.5 * (*th_hi - *th_lo);
   w.theta_sweep = theta_u[i1] - theta_u[i0];
-  double span = 0, sD = 0, sT = 0;
+  double span = 0, sD = 0, sT = 0, sTau = 0;
   for (std::size_t i = i0; i < i1; ++i) {
     const double h = t[i + 1] - t[i];
     span += h;
     sD += 0.5 * h * (D12[i] + D12[i + 1]);
     sT += 0.5 * h * (theta_u[i] + theta_u[i + 1]);
+    sTau += 0.5 * h * (tau_min[i] + tau_min[i + 1]);
   }
   w.mean_D12 = span > 0 ? sD / span : D12[i0];
-  w.theta_mean = span > 0 ? sT / span : theta_u[i0];
+  // Unwrapped θ carries the multiples of π picked up on the way (e.g. from the noisy θ of a sphere at
+  // rest); the mean axis is reported in (−π/2, π/2] like θ itself.
+  w.theta_mean = wrap_axis_angle(span > 0 ? sT / span : theta_u[i0]);
+  w.mean_tau_min = span > 0 ? sTau / span : tau_min[i0];
 }
 
 // Periods of a tumbling axis: back from the last sample, each window ends where the previous one began and
@@ -160,17 +173,21 @@ PeriodAnalysis analyse_periods(std::span<const double> t, std::span<const double
     res.mean_D12 = last.mean_D12;
     res.theta_mean = last.theta_mean;
     res.theta_amplitude = last.theta_amplitude;
+    res.min_tau_min = last.min_tau_min;
+    res.mean_tau_min = last.mean_tau_min;
+    res.tau_min_spread = last.max_tau_min - last.min_tau_min;
     return res;
   };
 
-  // 1. Steady: a stationary trailing window.
+  // 1. Steady: D12 and θ stationary over the trailing window (PeriodOptions says why these tests).
   if (t.back() - t.front() >= options.steady_window) {
     std::size_t i0 = n - 1;
     while (i0 > 0 && t[i0 - 1] >= t.back() - options.steady_window) --i0;
     const auto [d_lo, d_hi] = std::minmax_element(D12.begin() + i0, D12.end());
     const auto [th_lo, th_hi] = std::minmax_element(theta_u.begin() + i0, theta_u.end());
-    const bool circular = *d_hi <= options.steady_tol_D12;
-    if (*d_hi - *d_lo <= options.steady_tol_D12 && (circular || *th_hi - *th_lo <= options.steady_tol_theta)) {
+    const double tol = options.steady_tolerance;
+    // 2 D12 Δθ ≤ tol, written without dividing so that a circular section (D12 = 0) passes.
+    if (*d_hi - *d_lo <= tol && 2.0 * std::abs(*d_hi) * (*th_hi - *th_lo) <= tol) {
       PeriodWindow w;
       w.t_begin = t[i0];
       w.t_end = t.back();

@@ -35,6 +35,14 @@ enum class Regime {
 /// @brief "unknown" | "steady" | "tumbling" | "swinging".
 std::string_view to_string(Regime regime);
 
+/// @brief Tolerances of the stopping test.
+struct ConvergenceOptions {
+  double tol_D12 = 1e-3;      ///< absolute, on min D12 (D12 near the transition is ~0: no relative tol)
+  double tol_tau_min = 1e-3;  ///< absolute, on max τmin (units of Gs)
+  double tol_period = 0.02;   ///< relative, on the period
+  int periods = 2;            ///< number of successive periods that must agree pairwise (≥ 2)
+};
+
 /// @brief Tunables of analyse_periods.
 struct PeriodOptions {
   /// A minimum of D12 is significant when D12 rises by at least max(min_prominence,
@@ -42,12 +50,25 @@ struct PeriodOptions {
   /// Small wiggles (sampling noise, wrinkles) are thus not taken for periods.
   double prominence_fraction = 0.2;
   double min_prominence = 1e-4;
-  /// Steady when, over the last `steady_window` time units, max − min of D12 ≤ steady_tol_D12 and of θ
-  /// (unwrapped) ≤ steady_tol_theta. θ is ignored when D12 ≤ steady_tol_D12 there (a circular section has
-  /// no long axis, its θ is noise).
+  /// Steady state (DESIGN.md §4), recognised from the shape alone: over the trailing `steady_window` time
+  /// units (1/γ̇) the spread max − min of D12 is ≤ steady_tolerance, and so is the shape change 2·D12·Δθ
+  /// that the spread Δθ of the (unwrapped) inclination makes, i.e. Δθ ≤ steady_tolerance / (2 max D12).
+  /// τmin is not tested: without bending stiffness a compressed membrane wrinkles at the mesh scale and
+  /// τmin, a pointwise minimum over the surface, flickers by O(10⁻²) while the shape is stationary to 10⁻³.
+  ///
+  /// Why these. The tolerance is the one the stop test puts on min D12 between successive periods (the
+  /// driver passes time.period_tolerance): a steady state is a periodic one whose period has shrunk to
+  /// nothing, so it must be stationary to the same accuracy. The spread bounds the drift too (a trend of
+  /// slope s moves D12 by s·window across the window), so a transient still relaxing by more than the
+  /// tolerance per window is rejected. The θ bound converts a rotation into the boundary displacement it
+  /// causes on an ellipse of Taylor parameter D (≈ 2 D δθ, against δD for a change of D12), so D12 and θ
+  /// are held to the same shape accuracy; as D12 → 0 (a circular section, whose θ is noise) it relaxes
+  /// by itself. The window: the shape relaxes on the membrane time scale, O(1) in units of 1/γ̇ for the
+  /// Ca of interest (0.1–1), and wrinkles flicker on much shorter scales, so 5 units covers several
+  /// relaxation times (a transient with time constant τ ≲ 1 has decayed by e⁻⁵ across it if its spread
+  /// passes) and many flicker cycles (so max/min/mean of τmin over it are meaningful statistics).
   double steady_window = 5.0;
-  double steady_tol_D12 = 1e-4;
-  double steady_tol_theta = 1e-3;
+  double steady_tolerance = ConvergenceOptions{}.tol_D12;
   /// At most this many most-recent periods are analysed.
   int max_periods = 16;
 };
@@ -58,23 +79,36 @@ struct PeriodWindow {
   std::size_t i_begin = 0, i_end = 0;   ///< samples [i_begin, i_end] over which the extrema are taken
   double min_D12 = 0, max_D12 = 0, mean_D12 = 0;  ///< mean: trapezoidal time average
   double max_tau_min = 0;               ///< max over the window of τmin(t), seed eq. (13)
+  double min_tau_min = 0, mean_tau_min = 0;  ///< min and time mean over the window of τmin(t)
   double theta_sweep = 0;               ///< θ(end) − θ(begin), unwrapped: ≈ −π tumbling, ≈ 0 swinging
-  double theta_mean = 0, theta_amplitude = 0;  ///< time mean and half range of unwrapped θ
+  double theta_mean = 0, theta_amplitude = 0;  ///< time mean (in (−π/2, π/2]) and half range of unwrapped θ
   /// @brief Duration of the window.
   [[nodiscard]] double period() const { return t_end - t_begin; }
 };
 
 /// @brief Result of analyse_periods. The scalar results are those of the last full period (periods[0]);
-/// NaN when unknown. For a steady regime: period = 0 and the scalars are over the stationary window.
+/// NaN when unknown.
+///
+/// Steady regime: period = revolution_period = 0 and periods[0] is the stationary trailing window; the
+/// scalars are its statistics. mean_D12 and theta_mean (time means) are the steady D12 and θ; min_D12 is
+/// the smallest D12 in the window (the steady D12 to within PeriodOptions::steady_tolerance) and
+/// max_tau_min the largest τmin(t) in it. These keep the meaning the Table 1 analysis gives them for a
+/// periodic regime (extrema over the analysed window): Ca* needs min D12 < 0.05 somewhere, and CaH is
+/// where max τmin < 0, i.e. where the membrane is compressed somewhere at every instant — with a
+/// flickering τmin the window's maximum is the least compressed instant, so max_tau_min < 0 still means
+/// "never free of compression", as it does over a period. min_tau_min, mean_tau_min and tau_min_spread
+/// show how much of it is flicker.
 struct PeriodAnalysis {
   Regime regime = Regime::unknown;
   static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-  double period = kNaN;             ///< shape period = period of D12(t) (see file comment)
+  double period = kNaN;             ///< shape period = period of D12(t) (see file comment); 0 when steady
   double revolution_period = kNaN;  ///< 2 · period: return time of the material point P
   double min_D12 = kNaN, max_tau_min = kNaN, mean_D12 = kNaN;
   double theta_mean = kNaN, theta_amplitude = kNaN;
+  double min_tau_min = kNaN, mean_tau_min = kNaN;  ///< statistics of τmin(t) over the same window
+  double tau_min_spread = kNaN;                    ///< max_tau_min − min_tau_min
   /// Complete periods found, the most recent first. Tumbling: successive turns of θ by π back from the
-  /// last sample. Swinging: between successive significant minima of D12.
+  /// last sample. Swinging: between successive significant minima of D12. Steady: the one trailing window.
   std::vector<PeriodWindow> periods;
 };
 
@@ -90,7 +124,7 @@ std::vector<std::size_t> significant_minima(std::span<const double> y, double pr
 /// @brief Analyse the record: regime, period, min D12, max τmin, mean D12 over the last full period.
 ///
 /// Rules, in order:
-/// 1. steady if the last steady_window is stationary (see PeriodOptions);
+/// 1. steady if D12 and θ are stationary over the last steady_window (see PeriodOptions), whatever τmin does;
 /// 2. with ≥ 2 significant minima of D12: the last interval between them is one period; tumbling if θ turns
 ///    there by more than π/2 (expected π), else swinging. Tumbling periods are then taken from θ (3);
 ///    swinging periods are the intervals between successive minima;
@@ -106,14 +140,6 @@ PeriodAnalysis analyse_periods(std::span<const double> t, std::span<const double
 
 /// @brief Same, on a TimeSeries.
 PeriodAnalysis analyse_periods(const TimeSeries& series, const PeriodOptions& options = {});
-
-/// @brief Tolerances of the stopping test.
-struct ConvergenceOptions {
-  double tol_D12 = 1e-3;      ///< absolute, on min D12 (D12 near the transition is ~0: no relative tol)
-  double tol_tau_min = 1e-3;  ///< absolute, on max τmin (units of Gs)
-  double tol_period = 0.02;   ///< relative, on the period
-  int periods = 2;            ///< number of successive periods that must agree pairwise (≥ 2)
-};
 
 /// @brief The stopping test of DESIGN.md §4: true when the regime is steady, or periodic (tumbling or
 /// swinging) with the last `periods` full periods agreeing pairwise on min D12, max τmin and the period.

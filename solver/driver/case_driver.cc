@@ -147,6 +147,8 @@ CaseResult run_case(const config::CaseConfig& config, const RunOptions& options)
   auto last_progress = Clock::now();
   diagnostics::ConvergenceOptions conv;
   conv.tol_D12 = conv.tol_tau_min = config.period_tolerance;
+  diagnostics::PeriodOptions period_options;
+  period_options.steady_tolerance = config.period_tolerance;  // a steady state is held to the same accuracy
 
   while (true) {
     if ((options.stop_requested && options.stop_requested->load()) ||
@@ -207,7 +209,7 @@ CaseResult run_case(const config::CaseConfig& config, const RunOptions& options)
     }
     if (t >= next_check - eps) {
       next_check += config.check_interval;
-      r.analysis = diagnostics::analyse_periods(series);
+      r.analysis = diagnostics::analyse_periods(series, period_options);
       if (diagnostics::periodic_regime_converged(r.analysis, conv)) {
         r.converged = true;
         r.status = "done";
@@ -229,7 +231,7 @@ CaseResult run_case(const config::CaseConfig& config, const RunOptions& options)
   // --- Output: final analysis and summary attributes.
   r.wrinkle_final = sample_wrinkle(x);
   r.wrinkle_max = wrinkle_max;
-  if (!series.empty()) r.analysis = diagnostics::analyse_periods(series);
+  if (!series.empty()) r.analysis = diagnostics::analyse_periods(series, period_options);
   const double V = membrane::area_and_volume(mesh, x).volume;
   r.volume_drift = (V - V0) / V0;
   r.steps = step;

@@ -6,6 +6,7 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/IterativeLinearSolvers>
 
+#include "solver/membrane/membrane_mechanics.h"  // DegenerateSurface
 #include "solver/mesh/p2_element.h"
 #include "solver/quadrature/triangle_rule.h"
 
@@ -86,7 +87,7 @@ void LoadSolver::factorize() {
   if (options_.backend == Backend::Cholmod) {
     impl_->cholmod.factorize(M_);
     if (impl_->cholmod.info() != Eigen::Success)
-      throw std::runtime_error("CHOLMOD: the mass matrix is not positive definite (surface degenerated)");
+      throw DegenerateSurface("CHOLMOD: the mass matrix is not positive definite (surface degenerated)");
   } else {
     impl_->cg.setTolerance(options_.cg_tolerance);
     impl_->cg.compute(M_);
@@ -98,12 +99,20 @@ void LoadSolver::solve(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
   if (options_.backend == Backend::Cholmod) {
     q = impl_->cholmod.solve(rhs).transpose();
     last_iterations_ = 0;
+    // CHOLMOD's positive-definiteness test lets a NaN matrix through (NaN pivots compare false).
+    if (!q.allFinite()) throw DegenerateSurface("CHOLMOD: non-finite load (surface degenerated)");
   } else {
     Eigen::MatrixX3d sol(R.cols(), 3);
     last_iterations_ = 0;
     for (int c = 0; c < 3; ++c) {
       sol.col(c) = impl_->cg.solve(rhs.col(c));
       last_iterations_ += static_cast<int>(impl_->cg.iterations());
+      // M is SPD with a condition number bounded independently of h on any valid surface, so CG converges
+      // in a few dozen iterations; not converging means M is not SPD (a NaN position, a collapsed surface).
+      if (impl_->cg.info() != Eigen::Success || !sol.col(c).allFinite())
+        throw DegenerateSurface("CG: the load solve did not converge (residual " + std::to_string(impl_->cg.error()) +
+                                " after " + std::to_string(impl_->cg.iterations()) +
+                                " iterations): the mass matrix is not positive definite (surface degenerated)");
     }
     q = sol.transpose();
   }

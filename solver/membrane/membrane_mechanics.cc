@@ -110,8 +110,10 @@ MembraneState MembraneMechanics::evaluate(const Eigen::Matrix3Xd& x) const {
     s.energy += r.weight0 * law_.energy(inv.I1, inv.Js);
     const EnergyDerivatives d = law_.derivatives(inv.I1, inv.Js);
     const auto tau = std::array<double, 2>{2.0 * d.d_I1 * inv.l1 / inv.l2 + d.d_Js, 2.0 * d.d_I1 * inv.l2 / inv.l1 + d.d_Js};
-    s.tau_min = std::min(s.tau_min, tau[1]);
-    s.tau_max = std::max(s.tau_max, tau[0]);
+    // λ1 ≥ λ2 does not order the tensions: Skalak's τ1 − τ2 = (λ1² + λ2² − 1)(λ1/λ2 − λ2/λ1) is negative
+    // under strong compression (DESIGN.md §2), so both are compared.
+    s.tau_min = std::min({s.tau_min, tau[0], tau[1]});
+    s.tau_max = std::max({s.tau_max, tau[0], tau[1]});
     // A^{αβ} = 2 ws_I1 G^{αβ} + ws_J Js g^{αβ}, with g^{αβ} the inverse current metric.
     const double ginv11 = k.g22 / k.det_g, ginv12 = -k.g12 / k.det_g, ginv22 = k.g11 / k.det_g;
     const double c1 = 2.0 * d.d_I1, c2 = d.d_Js * inv.Js;
@@ -151,7 +153,8 @@ std::vector<std::array<double, 2>> MembraneMechanics::principal_tensions(const E
   out.reserve(ref_.size());
   for_each_point(x, [&](int, int, const RefPoint& r, const PointKinematics& k) {
     const Invariants inv = invariants(r, k);
-    out.push_back(law_.tensions(inv.l1, inv.l2));
+    const auto tau = law_.tensions(inv.l1, inv.l2);  // along λ1, along λ2: not always τ1 ≥ τ2 (see evaluate)
+    out.push_back({std::max(tau[0], tau[1]), std::min(tau[0], tau[1])});
   });
   return out;
 }

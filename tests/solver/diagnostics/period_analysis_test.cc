@@ -1,6 +1,7 @@
 // Period, extrema and regime detection on synthetic signals with known answers.
 #include "solver/diagnostics/period_analysis.h"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <numbers>
@@ -187,6 +188,82 @@ TEST(PeriodAnalysis, UndeformedSphereIsSteadyWhateverItsNoisyInclination) {
     tau = 0;
   }));
   EXPECT_EQ(a.regime, Regime::steady);
+}
+
+// Issue 12 §3: a tank-treading sphere whose shape is stationary to ~1e-3 while τmin, a pointwise minimum
+// over a wrinkling membrane, flickers by a few 1e-2. The old rule (spread of D12 ≤ 1e-4) never called it
+// steady; the analysis must report it steady, with D12, θ and the statistics of τmin over the window.
+TEST(PeriodAnalysis, StationaryShapeWithFlickeringTauMinIsSteady) {
+  const double D = 0.39, th0 = 0.45;
+  // Flicker: a sum of incommensurate fast modes (a deterministic stand-in for mesh-scale wrinkles).
+  auto flicker = [](double t) { return std::sin(41.3 * t) * std::cos(17.1 * t + 0.4) + 0.5 * std::sin(97.0 * t); };
+  auto f = [&](double t, double& d, double& th, double& tau) {
+    d = D * (1 - std::exp(-2 * t)) + 3e-4 * flicker(t);
+    th = th0 + 0.3 * std::exp(-2 * t) + 2e-4 * flicker(1.7 * t);
+    tau = -0.004 + 0.02 * flicker(2.3 * t);
+  };
+  const auto a = analyse(sample(12.0, 0.01, f, 0.3));
+  ASSERT_EQ(a.regime, Regime::steady);
+  EXPECT_EQ(a.period, 0.0);
+  EXPECT_EQ(a.revolution_period, 0.0);
+  // The steady D12 and θ: time means over the window, to within the flicker's amplitude.
+  EXPECT_NEAR(a.mean_D12, D, 1e-4);
+  EXPECT_NEAR(a.theta_mean, th0, 1e-4);
+  EXPECT_NEAR(a.min_D12, D, 1e-3);
+  EXPECT_LE(a.min_D12, a.mean_D12);
+  // τmin statistics over the same window, against the samples themselves.
+  const Signal s = sample(12.0, 0.01, f, 0.3);
+  double lo = INFINITY, hi = -INFINITY;
+  for (std::size_t i = 0; i < s.t.size(); ++i)
+    if (s.t[i] >= s.t.back() - PeriodOptions{}.steady_window) lo = std::min(lo, s.tau_min[i]), hi = std::max(hi, s.tau_min[i]);
+  EXPECT_EQ(a.max_tau_min, hi);
+  EXPECT_EQ(a.min_tau_min, lo);
+  EXPECT_NEAR(a.tau_min_spread, hi - lo, 1e-15);
+  EXPECT_GT(a.tau_min_spread, 0.03);  // the flicker is there and is not taken for unsteadiness
+  EXPECT_NEAR(a.mean_tau_min, -0.004, 2e-3);
+  ASSERT_EQ(a.periods.size(), 1u);
+  EXPECT_NEAR(a.periods[0].period(), PeriodOptions{}.steady_window, 0.02);
+  EXPECT_TRUE(periodic_regime_converged(a));
+  // A tighter tolerance than the flicker of the shape refuses it.
+  PeriodOptions tight;
+  tight.steady_tolerance = 1e-4;
+  EXPECT_NE(analyse(s, tight).regime, Regime::steady);
+}
+
+TEST(PeriodAnalysis, SlowlyDriftingShapeIsNotSteady) {
+  // D12 creeping up by 1e-3 per time unit (5e-3 over the window), θ fixed: not stationary.
+  auto f = [](double t, double& d, double& th, double& tau) {
+    d = 0.3 + 1e-3 * t;
+    th = 0.5;
+    tau = 0.01;
+  };
+  const auto a = analyse(sample(20.0, 0.01, f));
+  EXPECT_NE(a.regime, Regime::steady);
+  EXPECT_FALSE(periodic_regime_converged(a));
+  // θ drifting at a fixed shape is a slow rotation, not a steady state either.
+  auto g = [](double t, double& d, double& th, double& tau) {
+    d = 0.3;
+    th = 0.5 - 2e-3 * t;
+    tau = 0.01;
+  };
+  const auto b = analyse(sample(20.0, 0.01, g));
+  EXPECT_NE(b.regime, Regime::steady);
+  EXPECT_FALSE(periodic_regime_converged(b));
+}
+
+TEST(PeriodAnalysis, SlowTumblingIsNotSteady) {
+  // A long rigid ellipse (r = 10) lingers near the flow direction: its axis turns by only ≈ 0.05 rad over
+  // the 5-unit window there, while D12 is exactly constant. That is tumbling, never a steady state.
+  const double r = 10.0, D0 = (r - 1) / (r + 1);
+  auto f = [&](double t, double& d, double& th, double& tau) {
+    d = D0;
+    th = wrap_axis(jeffery_angle(t, r));
+    tau = 0.0;
+  };
+  for (double t_end : {6.0, 12.0, 20.0, 28.0}) EXPECT_NE(analyse(sample(t_end, 0.01, f)).regime, Regime::steady) << t_end;
+  const auto a = analyse(sample(40.0, 0.01, f));
+  EXPECT_EQ(a.regime, Regime::tumbling);
+  EXPECT_NEAR(a.period, kPi * (r + 1 / r), 1e-2);
 }
 
 TEST(PeriodAnalysis, TooLittleDataIsUnknown) {

@@ -1,5 +1,6 @@
 #include "solver/membrane/membrane_mechanics.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -183,6 +184,58 @@ TEST(LoadSolver, CholmodAndConjugateGradientAgree) {
   EXPECT_GT(cg.last_iterations(), 0);
   // The mass matrix integrates 1: Σ_ab M_ab = area.
   EXPECT_NEAR(direct.mass_matrix().sum(), area_and_volume(m, x).area, 1e-12);
+}
+
+// DESIGN.md §2: the tension along the larger stretch is not always the larger one. Skalak's
+// τ1 − τ2 = (λ1² + λ2² − 1)(λ1/λ2 − λ2/λ1) changes sign when λ1² + λ2² < 1 (strong compression), so
+// τmin must be the smaller of the two, not the second. An anisotropic compression of the sphere by
+// 0.5–0.7 puts every quadrature point in that state.
+TEST(MembraneMechanics, TauMinIsTheSmallerTensionWhenSkalakReversesTheOrder) {
+  const auto m = mesh::make_sphere_mesh(2);
+  const SkalakLaw law(1.0);
+  const MembraneMechanics mech(m, m.nodes, law);
+  const Matrix3Xd x = Eigen::Vector3d(0.7, 0.5, 0.6).asDiagonal() * m.nodes;
+  const auto stretches = mech.principal_stretches(x);
+  double lo = INFINITY, hi = -INFINITY;
+  int reversed = 0;
+  for (const auto& l : stretches) {
+    ASSERT_LT(l[0] * l[0] + l[1] * l[1], 1.0);  // the reversed regime, by construction
+    const auto tau = law.tensions(l[0], l[1]);  // tension along λ1, along λ2
+    if (l[0] > l[1] * (1 + 1e-6) && tau[0] < tau[1]) ++reversed;
+    lo = std::min({lo, tau[0], tau[1]});
+    hi = std::max({hi, tau[0], tau[1]});
+  }
+  ASSERT_GT(reversed, 0) << "the state does not reverse the order: the test would not test anything";
+  const auto s = mech.evaluate(x);
+  EXPECT_DOUBLE_EQ(s.tau_min, lo);
+  EXPECT_DOUBLE_EQ(s.tau_max, hi);
+  // principal_tensions keeps its contract τ1 ≥ τ2 (the compressed-area fraction tests τ2 < 0).
+  int unordered = 0;
+  for (const auto& tau : mech.principal_tensions(x)) unordered += tau[0] < tau[1];
+  EXPECT_EQ(unordered, 0);
+}
+
+// Defect 3 of issue 12: the CG backend never looked at its convergence, so a degenerate surface (a NaN
+// position, a surface collapsed to a point: the mass matrix is NaN or zero) gave a NaN or garbage load
+// silently instead of DegenerateSurface, which the driver turns into an `unstable` outcome.
+TEST(LoadSolver, DegenerateSurfaceIsReportedByEitherBackend) {
+  const auto m = mesh::make_capsule_mesh(2, 2.0);
+  const SkalakLaw law(1.0);
+  const MembraneMechanics mech(m, m.nodes, law);
+  const Matrix3Xd R = mech.evaluate(smooth_deformation(m.nodes, 0.2)).internal_force;
+  Matrix3Xd nan = m.nodes;
+  nan(1, 7) = std::nan("");
+  const Matrix3Xd point = Matrix3Xd::Zero(3, m.nodes.cols());
+  for (const auto backend : {LoadSolver::Backend::Cholmod, LoadSolver::Backend::ConjugateGradient}) {
+    const char* name = backend == LoadSolver::Backend::Cholmod ? "CHOLMOD" : "CG";
+    LoadSolver solver(m, {backend, 6, 1e-12});
+    Matrix3Xd q;
+    EXPECT_THROW(solver.compute_load(nan, R, q), DegenerateSurface) << name << ", NaN position";
+    EXPECT_THROW(solver.compute_load(point, R, q), DegenerateSurface) << name << ", surface collapsed to a point";
+    // The solver is still usable on a good surface afterwards.
+    EXPECT_NO_THROW(solver.compute_load(m.nodes, R, q)) << name;
+    EXPECT_TRUE(q.allFinite()) << name;
+  }
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 
 namespace capsim::diagnostics {
@@ -179,25 +180,44 @@ PeriodAnalysis analyse_periods(std::span<const double> t, std::span<const double
     return res;
   };
 
-  // 1. Steady: D12 and θ stationary over the trailing window (PeriodOptions says why these tests).
-  if (t.back() - t.front() >= options.steady_window) {
+  // The trailing steady window [i0, n − 1] and the spreads of D12 and θ over it.
+  struct Trailing {
+    std::size_t i0;
+    double d_lo, d_hi, th_spread;
+  };
+  auto trailing = [&]() -> std::optional<Trailing> {
+    if (t.back() - t.front() < options.steady_window) return std::nullopt;
     std::size_t i0 = n - 1;
     while (i0 > 0 && t[i0 - 1] >= t.back() - options.steady_window) --i0;
     const auto [d_lo, d_hi] = std::minmax_element(D12.begin() + i0, D12.end());
     const auto [th_lo, th_hi] = std::minmax_element(theta_u.begin() + i0, theta_u.end());
-    const double tol = options.steady_tolerance;
-    // 2 D12 Δθ ≤ tol, written without dividing so that a circular section (D12 = 0) passes.
-    if (*d_hi - *d_lo <= tol && 2.0 * std::abs(*d_hi) * (*th_hi - *th_lo) <= tol) {
-      PeriodWindow w;
-      w.t_begin = t[i0];
-      w.t_end = t.back();
-      w.i_begin = i0;
-      w.i_end = n - 1;
-      finish(Regime::steady, {w});
-      res.period = 0;
-      res.revolution_period = 0;
-      return res;
-    }
+    return Trailing{i0, *d_lo, *d_hi, *th_hi - *th_lo};
+  };
+  auto steady = [&](const Trailing& w) {
+    PeriodWindow win;
+    win.t_begin = t[w.i0];
+    win.t_end = t.back();
+    win.i_begin = w.i0;
+    win.i_end = n - 1;
+    finish(Regime::steady, {win});
+    res.period = 0;
+    res.revolution_period = 0;
+    return res;
+  };
+  const std::optional<Trailing> tail = trailing();
+
+  // 1. Settled: D12 and θ stationary to the strict tolerances (PeriodOptions says why two tests).
+  if (tail) {
+    const bool circular = tail->d_hi <= options.settled_tol_D12;
+    if (tail->d_hi - tail->d_lo <= options.settled_tol_D12 && (circular || tail->th_spread <= options.settled_tol_theta))
+      return steady(*tail);
+  }
+  // 1b. Stationary to the final-analysis tolerance (rule 2 of PeriodOptions). Before the periodic rules: the
+  // flicker of a wrinkling membrane makes "significant" D12 minima of its own, which are no swinging.
+  // 2 D12 Δθ ≤ tol is written without dividing so that a circular section (D12 = 0) passes.
+  if (tail && options.stationary_tolerance > 0) {
+    const double tol = options.stationary_tolerance;
+    if (tail->d_hi - tail->d_lo <= tol && 2.0 * std::abs(tail->d_hi) * tail->th_spread <= tol) return steady(*tail);
   }
 
   // 2. Significant minima of D12, with a prominence scaled on the recent oscillation.
@@ -230,7 +250,6 @@ PeriodAnalysis analyse_periods(std::span<const double> t, std::span<const double
   // 3. Quasi-rigid tumbling: θ turns by π with no significant D12 oscillation.
   if (!tumbling.empty()) return finish(Regime::tumbling, tumbling);
 
-  // 4. Not enough data.
   return res;
 }
 

@@ -50,25 +50,39 @@ struct PeriodOptions {
   /// Small wiggles (sampling noise, wrinkles) are thus not taken for periods.
   double prominence_fraction = 0.2;
   double min_prominence = 1e-4;
-  /// Steady state (DESIGN.md §4), recognised from the shape alone: over the trailing `steady_window` time
-  /// units (1/γ̇) the spread max − min of D12 is ≤ steady_tolerance, and so is the shape change 2·D12·Δθ
-  /// that the spread Δθ of the (unwrapped) inclination makes, i.e. Δθ ≤ steady_tolerance / (2 max D12).
-  /// τmin is not tested: without bending stiffness a compressed membrane wrinkles at the mesh scale and
-  /// τmin, a pointwise minimum over the surface, flickers by O(10⁻²) while the shape is stationary to 10⁻³.
+  /// Steady state (solver/README.md §4), recognised from the shape alone, by two tests of the trailing
+  /// `steady_window` time units (1/γ̇). τmin is never tested: without bending stiffness a compressed membrane
+  /// wrinkles at the mesh scale and τmin, a pointwise minimum over the surface, flickers by O(10⁻²) while
+  /// the shape is stationary to 10⁻³.
   ///
-  /// Why these. The tolerance is the one the stop test puts on min D12 between successive periods (the
-  /// driver passes time.period_tolerance): a steady state is a periodic one whose period has shrunk to
-  /// nothing, so it must be stationary to the same accuracy. The spread bounds the drift too (a trend of
-  /// slope s moves D12 by s·window across the window), so a transient still relaxing by more than the
-  /// tolerance per window is rejected. The θ bound converts a rotation into the boundary displacement it
-  /// causes on an ellipse of Taylor parameter D (≈ 2 D δθ, against δD for a change of D12), so D12 and θ
-  /// are held to the same shape accuracy; as D12 → 0 (a circular section, whose θ is noise) it relaxes
-  /// by itself. The window: the shape relaxes on the membrane time scale, O(1) in units of 1/γ̇ for the
-  /// Ca of interest (0.1–1), and wrinkles flicker on much shorter scales, so 5 units covers several
-  /// relaxation times (a transient with time constant τ ≲ 1 has decayed by e⁻⁵ across it if its spread
-  /// passes) and many flicker cycles (so max/min/mean of τmin over it are meaningful statistics).
+  /// 1. Settled (rule 1, tried first, and the only one the stop test sees): the spread max − min of D12 is
+  ///    ≤ settled_tol_D12 and that of the unwrapped θ ≤ settled_tol_theta (θ ignored when D12 ≤
+  ///    settled_tol_D12: a circular section has no long axis). Strict on purpose: a steady state offers no
+  ///    period-to-period comparison to confirm that the run has converged, so stopping a run early needs a
+  ///    shape settled well below the period tolerance.
+  /// 2. Stationary (tried next, before the periodic rules, and only where `stationary_tolerance` > 0 — the
+  ///    driver sets it for the final analysis of a run, to time.period_tolerance): the spread of D12 is
+  ///    ≤ stationary_tolerance, and so is the shape change 2·D12·Δθ that the spread Δθ of θ makes. This
+  ///    classifies what a run ended with (e.g. a sphere whose D12 flickers by 10⁻³ with the wrinkles, run to
+  ///    its t_end) instead of leaving it `unknown` or taking the flicker's own D12 minima for a swinging;
+  ///    the reported spreads say how steady it was. A real swinging or tumbling shape changes D12 by far more
+  ///    than the tolerance within any window of 5 time units, so it is never taken for steady.
+  ///
+  /// Why the stationary test. Its tolerance is the one the stop test puts on min D12 between successive
+  /// periods: a steady state is a periodic one whose period has shrunk to nothing, held to the same accuracy.
+  /// The spread bounds the drift too (a trend of slope s moves D12 by s·window across the window), so a
+  /// transient still relaxing by more than the tolerance per window is rejected. The θ bound converts a
+  /// rotation into the boundary displacement it causes on an ellipse of Taylor parameter D (≈ 2 D δθ,
+  /// against δD for a change of D12), so D12 and θ are held to the same shape accuracy; as D12 → 0 (a
+  /// circular section, whose θ is noise) it relaxes by itself. The window: the shape relaxes on the membrane
+  /// time scale, O(1) in units of 1/γ̇ for the Ca of interest (0.1–1), and wrinkles flicker on much shorter
+  /// scales, so 5 units covers several relaxation times (a transient with time constant τ ≲ 1 has decayed
+  /// by e⁻⁵ across it if its spread passes) and many flicker cycles (so max/min/mean of τmin over it are
+  /// meaningful statistics).
   double steady_window = 5.0;
-  double steady_tolerance = ConvergenceOptions{}.tol_D12;
+  double settled_tol_D12 = 1e-4;
+  double settled_tol_theta = 1e-3;
+  double stationary_tolerance = 0.0;  ///< 0: rule 4 off (as during the march)
   /// At most this many most-recent periods are analysed.
   int max_periods = 16;
 };
@@ -91,7 +105,7 @@ struct PeriodWindow {
 ///
 /// Steady regime: period = revolution_period = 0 and periods[0] is the stationary trailing window; the
 /// scalars are its statistics. mean_D12 and theta_mean (time means) are the steady D12 and θ; min_D12 is
-/// the smallest D12 in the window (the steady D12 to within PeriodOptions::steady_tolerance) and
+/// the smallest D12 in the window (the steady D12 to within the window's spread) and
 /// max_tau_min the largest τmin(t) in it. These keep the meaning the Table 1 analysis gives them for a
 /// periodic regime (extrema over the analysed window): Ca* needs min D12 < 0.05 somewhere, and CaH is
 /// where max τmin < 0, i.e. where the membrane is compressed somewhere at every instant — with a
@@ -124,7 +138,7 @@ std::vector<std::size_t> significant_minima(std::span<const double> y, double pr
 /// @brief Analyse the record: regime, period, min D12, max τmin, mean D12 over the last full period.
 ///
 /// Rules, in order:
-/// 1. steady if D12 and θ are stationary over the last steady_window (see PeriodOptions), whatever τmin does;
+/// 1. steady if D12 and θ have settled over the last steady_window (see PeriodOptions), whatever τmin does;
 /// 2. with ≥ 2 significant minima of D12: the last interval between them is one period; tumbling if θ turns
 ///    there by more than π/2 (expected π), else swinging. Tumbling periods are then taken from θ (3);
 ///    swinging periods are the intervals between successive minima;

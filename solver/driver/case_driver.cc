@@ -147,8 +147,11 @@ CaseResult run_case(const config::CaseConfig& config, const RunOptions& options)
   auto last_progress = Clock::now();
   diagnostics::ConvergenceOptions conv;
   conv.tol_D12 = conv.tol_tau_min = config.period_tolerance;
-  diagnostics::PeriodOptions period_options;
-  period_options.steady_tolerance = config.period_tolerance;  // a steady state is held to the same accuracy
+  // During the march only a settled steady state may stop the run; the final analysis also classifies a
+  // shape that ended stationary to the period tolerance (diagnostics::PeriodOptions).
+  const diagnostics::PeriodOptions period_options;
+  diagnostics::PeriodOptions final_options;
+  final_options.stationary_tolerance = config.period_tolerance;
 
   while (true) {
     if ((options.stop_requested && options.stop_requested->load()) ||
@@ -231,7 +234,7 @@ CaseResult run_case(const config::CaseConfig& config, const RunOptions& options)
   // --- Output: final analysis and summary attributes.
   r.wrinkle_final = sample_wrinkle(x);
   r.wrinkle_max = wrinkle_max;
-  if (!series.empty()) r.analysis = diagnostics::analyse_periods(series, period_options);
+  if (!series.empty()) r.analysis = diagnostics::analyse_periods(series, final_options);
   const double V = membrane::area_and_volume(mesh, x).volume;
   r.volume_drift = (V - V0) / V0;
   r.steps = step;

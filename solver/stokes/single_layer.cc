@@ -209,11 +209,7 @@ void SingleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Ma
         // r = x0 − x = −d; Duffy points are interior, so r ≠ 0 on a non-degenerate element.
         const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         const double inv = kernel::rsqrt_arith(r2);
-        const double rq = -(d[0] * qq[0] + d[1] * qq[1] + d[2] * qq[2]);
-        const double sc = rq * inv * inv;
-        sx += wj * inv * (qq[0] - d[0] * sc);
-        sy += wj * inv * (qq[1] - d[1] * sc);
-        sz += wj * inv * (qq[2] - d[2] * sc);
+        kernel::add_stokeslet(-d[0], -d[1], -d[2], qq[0], qq[1], qq[2], inv, wj, sx, sy, sz);
       }
       acc[0] += sx;
       acc[1] += sy;

@@ -41,10 +41,7 @@ inline void add_block(const double x0[3], const double* px, const double* py, co
     const double dx = x0[0] - px[p], dy = x0[1] - py[p], dz = x0[2] - pz[p];
     const double r2 = dx * dx + dy * dy + dz * dz;
     const double inv = r2 == 0.0 ? 0.0 : kernel::rsqrt_arith(r2);
-    const double sc = (dx * qx[p] + dy * qy[p] + dz * qz[p]) * inv * inv * inv;
-    ax += qx[p] * inv + dx * sc;
-    ay += qy[p] * inv + dy * sc;
-    az += qz[p] * inv + dz * sc;
+    kernel::add_stokeslet(dx, dy, dz, qx[p], qy[p], qz[p], inv, 1.0, ax, ay, az);
   }
   acc[0] += sign * ax;
   acc[1] += sign * ay;

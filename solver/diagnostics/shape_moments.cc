@@ -8,8 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "solver/mesh/p2_element.h"
-#include "solver/quadrature/triangle_rule.h"
+#include "solver/mesh/p2_tabulation.h"
 
 namespace capsim::diagnostics {
 
@@ -17,18 +16,8 @@ ShapeMoments shape_moments(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd
   if (x.cols() != mesh.num_nodes())
     throw std::invalid_argument("shape_moments: positions have " + std::to_string(x.cols()) +
                                 " columns, mesh has " + std::to_string(mesh.num_nodes()) + " nodes");
-  const auto& rule = quadrature::triangle_rule(rule_degree);
-  const int nq = rule.size();
-
-  // Shape functions at the rule's points are the same for every element: tabulate them once.
-  std::vector<std::array<double, 6>> N(nq), dNdxi(nq), dNdeta(nq);
-  for (int q = 0; q < nq; ++q) {
-    const double xi = rule.points[q][1], eta = rule.points[q][2];
-    N[q] = mesh::p2_shape(xi, eta);
-    const auto g = mesh::p2_shape_gradients(xi, eta);
-    dNdxi[q] = g[0];
-    dNdeta[q] = g[1];
-  }
+  const auto p2 = mesh::P2Tabulation::of_degree(rule_degree);
+  const int nq = p2.size();
 
   // Shift to the node mean: the divergence-theorem integrals hold about any origin, and a local one keeps
   // ∫ x x^T − V c c^T free of cancellation for a capsule that has drifted from the origin.
@@ -41,14 +30,10 @@ ShapeMoments shape_moments(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd
     Eigen::Matrix<double, 3, 6> xe;
     for (int a = 0; a < 6; ++a) xe.col(a) = x.col(e[a]) - origin;
     for (int q = 0; q < nq; ++q) {
-      Eigen::Vector3d p = Eigen::Vector3d::Zero(), t1 = Eigen::Vector3d::Zero(), t2 = Eigen::Vector3d::Zero();
-      for (int a = 0; a < 6; ++a) {
-        p += N[q][a] * xe.col(a);
-        t1 += dNdxi[q][a] * xe.col(a);
-        t2 += dNdeta[q][a] * xe.col(a);
-      }
-      // ∫ over the unit right triangle = ½ Σ w f; n dS = (t1 × t2) dξ dη exactly.
-      const Eigen::Vector3d ndS = (0.5 * rule.weights[q]) * t1.cross(t2);
+      const Eigen::Vector3d p = p2.interpolate(xe, q);
+      const auto [t1, t2] = p2.tangents(xe, q);
+      // n dS = (t1 × t2) dξ dη exactly; the weight is in dξ dη.
+      const Eigen::Vector3d ndS = p2.weight(q) * t1.cross(t2);
       const double xn = p.dot(ndS);
       three_volume += xn;
       area += ndS.norm();

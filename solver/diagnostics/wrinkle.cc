@@ -4,32 +4,23 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "solver/mesh/p2_element.h"
-#include "solver/quadrature/triangle_rule.h"
+#include "solver/mesh/p2_tabulation.h"
 
 namespace capsim::diagnostics {
 
 double compressed_area_fraction(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x,
                                 std::span<const std::array<double, 2>> tensions, int degree) {
-  const auto& rule = quadrature::triangle_rule(degree);
-  const int ne = mesh.num_elements(), nq = rule.size();
+  const auto p2 = mesh::P2Tabulation::of_degree(degree);
+  const int ne = mesh.num_elements(), nq = p2.size();
   if (static_cast<long>(tensions.size()) != static_cast<long>(ne) * nq)
     throw std::invalid_argument("compressed_area_fraction: expected one tension pair per quadrature point");
   if (x.cols() != mesh.num_nodes()) throw std::invalid_argument("compressed_area_fraction: x has the wrong size");
-  std::vector<std::array<std::array<double, 6>, 2>> grad(static_cast<std::size_t>(nq));
-  for (int k = 0; k < nq; ++k) grad[k] = mesh::p2_shape_gradients(rule.points[k][1], rule.points[k][2]);
   double total = 0, compressed = 0;
   for (int e = 0; e < ne; ++e) {
     const auto& el = mesh.elements[e];
     for (int k = 0; k < nq; ++k) {
       // Current area element |∂x/∂ξ × ∂x/∂η| on the exact P2 geometry.
-      const auto& g = grad[k];
-      Eigen::Vector3d t1 = Eigen::Vector3d::Zero(), t2 = Eigen::Vector3d::Zero();
-      for (int a = 0; a < 6; ++a) {
-        t1 += g[0][a] * x.col(el[a]);
-        t2 += g[1][a] * x.col(el[a]);
-      }
-      const double dA = 0.5 * rule.weights[k] * t1.cross(t2).norm();
+      const double dA = p2.weight(k) * p2.area_element(x, el, k);
       total += dA;
       if (tensions[static_cast<std::size_t>(e) * nq + k][1] < 0.0) compressed += dA;
     }

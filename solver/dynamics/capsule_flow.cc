@@ -4,8 +4,6 @@
 #include <chrono>
 #include <numbers>
 
-#include "solver/mesh/p2_element.h"
-#include "solver/quadrature/triangle_rule.h"
 
 namespace capsim::dynamics {
 namespace {
@@ -31,12 +29,7 @@ CapsuleFlow::CapsuleFlow(const config::CaseConfig& c) : Ca_(c.capillary_number) 
   so.far_radius = c.far_radius;
   single_layer_ = std::make_unique<stokes::SingleLayer>(*mesh_, so);
   volume_correction_ = c.volume_correction;
-  const auto& rule = quadrature::triangle_rule(6);
-  for (int k = 0; k < rule.size(); ++k) {
-    flux_N_.push_back(mesh::p2_shape(rule.points[k][1], rule.points[k][2]));
-    flux_dN_.push_back(mesh::p2_shape_gradients(rule.points[k][1], rule.points[k][2]));
-    flux_w_.push_back(0.5 * rule.weights[k]);
-  }
+  flux_rule_ = mesh::P2Tabulation::of_degree(6);
 }
 
 CapsuleFlow::~CapsuleFlow() = default;
@@ -75,16 +68,10 @@ FlowEvaluation CapsuleFlow::velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd
   normals_ = mesh::node_normals(*mesh_, x);
   double flux_v = 0.0, flux_n = 0.0;
   for (const auto& el : mesh_->elements) {
-    for (std::size_t k = 0; k < flux_w_.size(); ++k) {
-      Eigen::Vector3d g1 = Eigen::Vector3d::Zero(), g2 = Eigen::Vector3d::Zero(), vq = Eigen::Vector3d::Zero(),
-                      nq = Eigen::Vector3d::Zero();
-      for (int a = 0; a < 6; ++a) {
-        g1 += flux_dN_[k][0][a] * x.col(el[a]);
-        g2 += flux_dN_[k][1][a] * x.col(el[a]);
-        vq += flux_N_[k][a] * v.col(el[a]);
-        nq += flux_N_[k][a] * normals_.col(el[a]);
-      }
-      const Eigen::Vector3d nda = flux_w_[k] * g1.cross(g2);
+    for (int k = 0; k < flux_rule_.size(); ++k) {
+      const auto [g1, g2] = flux_rule_.tangents(x, el, k);
+      const Eigen::Vector3d vq = flux_rule_.interpolate(v, el, k), nq = flux_rule_.interpolate(normals_, el, k);
+      const Eigen::Vector3d nda = flux_rule_.weight(k) * g1.cross(g2);
       flux_v += vq.dot(nda);
       flux_n += nq.dot(nda);
     }

@@ -22,6 +22,7 @@
 #include "solver/membrane/membrane_law.h"
 #include "solver/membrane/membrane_mechanics.h"
 #include "solver/mesh/mesh.h"
+#include "solver/mesh/p2_tabulation.h"
 #include "solver/stokes/single_layer.h"
 
 namespace capsim::dynamics {
@@ -82,9 +83,7 @@ class CapsuleFlow {
   bool background_flow_ = true;
   bool volume_correction_ = true;
   // Rule of the flux integral: shape functions and derivatives at its points, weights · ½.
-  std::vector<std::array<double, 6>> flux_N_;
-  std::vector<std::array<std::array<double, 6>, 2>> flux_dN_;
-  std::vector<double> flux_w_;
+  mesh::P2Tabulation flux_rule_;  // degree-6 rule of the volume-flux integral
   Eigen::Matrix3Xd normals_;
 };
 

@@ -7,27 +7,19 @@
 #include <Eigen/IterativeLinearSolvers>
 
 #include "solver/membrane/membrane_mechanics.h"  // DegenerateSurface
-#include "solver/mesh/p2_element.h"
-#include "solver/quadrature/triangle_rule.h"
+#include "solver/mesh/p2_tabulation.h"
 
 namespace capsim::membrane {
 
 struct LoadSolver::Impl {
   Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> cholmod;
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
-  std::vector<std::array<double, 6>> N;                      // per rule point
-  std::vector<std::array<std::array<double, 6>, 2>> dN;      // per rule point
-  std::vector<double> w;                                     // rule weights · ½
+  mesh::P2Tabulation p2;                                     // the rule's points
 };
 
 LoadSolver::LoadSolver(const mesh::SurfaceMesh& mesh, Options options)
     : mesh_(mesh), options_(options), impl_(std::make_unique<Impl>()) {
-  const auto& rule = quadrature::triangle_rule(options.quadrature_degree);
-  for (int q = 0; q < rule.size(); ++q) {
-    impl_->N.push_back(mesh::p2_shape(rule.points[q][1], rule.points[q][2]));
-    impl_->dN.push_back(mesh::p2_shape_gradients(rule.points[q][1], rule.points[q][2]));
-    impl_->w.push_back(0.5 * rule.weights[q]);
-  }
+  impl_->p2 = mesh::P2Tabulation::of_degree(options.quadrature_degree);
   // Pattern from connectivity: every pair of nodes sharing an element.
   const int n = mesh.num_nodes();
   std::vector<Eigen::Triplet<double>> trip;
@@ -63,18 +55,14 @@ void LoadSolver::assemble(const Eigen::Matrix3Xd& x) {
   if (x.cols() != mesh_.num_nodes()) throw std::invalid_argument("LoadSolver: positions do not match the mesh");
   double* val = M_.valuePtr();
   std::fill(val, val + M_.nonZeros(), 0.0);
-  const int nq = static_cast<int>(impl_->w.size());
+  const mesh::P2Tabulation& p2 = impl_->p2;
+  const int nq = p2.size();
   for (int e = 0; e < mesh_.num_elements(); ++e) {
     const auto& el = mesh_.elements[e];
     double local[36] = {};
     for (int q = 0; q < nq; ++q) {
-      Eigen::Vector3d g1 = Eigen::Vector3d::Zero(), g2 = Eigen::Vector3d::Zero();
-      for (int a = 0; a < 6; ++a) {
-        g1 += impl_->dN[q][0][a] * x.col(el[a]);
-        g2 += impl_->dN[q][1][a] * x.col(el[a]);
-      }
-      const double da = impl_->w[q] * g1.cross(g2).norm();
-      const auto& N = impl_->N[q];
+      const double da = p2.weight(q) * p2.area_element(x, el, q);
+      const double* N = p2[q].n;
       for (int i = 0; i < 6; ++i)
         for (int j = 0; j < 6; ++j) local[i * 6 + j] += da * N[i] * N[j];
     }

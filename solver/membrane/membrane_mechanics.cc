@@ -6,8 +6,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "solver/mesh/p2_element.h"
-#include "solver/quadrature/triangle_rule.h"
 
 namespace capsim::membrane {
 namespace {
@@ -26,48 +24,41 @@ MembraneMechanics::MembraneMechanics(const mesh::SurfaceMesh& mesh, const Eigen:
   if (reference.cols() != mesh.num_nodes())
     throw std::invalid_argument("MembraneMechanics: reference has " + std::to_string(reference.cols()) +
                                 " nodes, mesh has " + std::to_string(mesh.num_nodes()));
-  const auto& rule = quadrature::triangle_rule(options.quadrature_degree);
-  for (const auto& p : rule.points) dN_.push_back(mesh::p2_shape_gradients(p[1], p[2]));
-  ref_.reserve(static_cast<std::size_t>(mesh.num_elements()) * rule.size());
+  p2_ = mesh::P2Tabulation::of_degree(options.quadrature_degree);
+  const int nq = p2_.size();
+  ref_.reserve(static_cast<std::size_t>(mesh.num_elements()) * nq);
   double max_area = 0.0;
   for (int e = 0; e < mesh.num_elements(); ++e) {
     const auto& el = mesh.elements[e];
-    for (int q = 0; q < rule.size(); ++q) {
-      Eigen::Vector3d G1 = Eigen::Vector3d::Zero(), G2 = Eigen::Vector3d::Zero();
-      for (int a = 0; a < 6; ++a) {
-        G1 += dN_[q][0][a] * reference.col(el[a]);
-        G2 += dN_[q][1][a] * reference.col(el[a]);
-      }
+    for (int q = 0; q < nq; ++q) {
+      const auto [G1, G2] = p2_.tangents(reference, el, q);
       const double G11 = G1.dot(G1), G12 = G1.dot(G2), G22 = G2.dot(G2);
       const double det = G11 * G22 - G12 * G12;
       max_area = std::max(max_area, det);
       if (!(det > 0.0))
         throw std::invalid_argument("membrane: element " + std::to_string(e) + " of the reference surface is degenerate");
-      ref_.push_back({{G22 / det, -G12 / det, G11 / det}, rule.weights[q] * 0.5 * std::sqrt(det)});
+      ref_.push_back({{G22 / det, -G12 / det, G11 / det}, p2_.weight(q) * std::sqrt(det)});
     }
   }
   // A collapsed element relative to the others is as bad as a zero one: its metric is ill-conditioned.
   for (std::size_t i = 0; i < ref_.size(); ++i) {
     const double det = 1.0 / (ref_[i].Ginv[0] * ref_[i].Ginv[2] - ref_[i].Ginv[1] * ref_[i].Ginv[1]);
     if (det < 1e-20 * max_area)
-      throw std::invalid_argument("membrane: element " + std::to_string(i / rule.size()) +
+      throw std::invalid_argument("membrane: element " + std::to_string(i / nq) +
                                   " of the reference surface is degenerate");
   }
 }
 
 template <class Visit>
 void MembraneMechanics::for_each_point(const Eigen::Matrix3Xd& x, Visit&& visit) const {
-  const int nq = static_cast<int>(dN_.size());
+  const int nq = p2_.size();
   for (int e = 0; e < mesh_.num_elements(); ++e) {
     const auto& el = mesh_.elements[e];
     for (int q = 0; q < nq; ++q) {
       PointKinematics k;
-      k.g1.setZero();
-      k.g2.setZero();
-      for (int a = 0; a < 6; ++a) {
-        k.g1 += dN_[q][0][a] * x.col(el[a]);
-        k.g2 += dN_[q][1][a] * x.col(el[a]);
-      }
+      const mesh::Tangents g = p2_.tangents(x, el, q);
+      k.g1 = g.g1;
+      k.g2 = g.g2;
       k.g11 = k.g1.dot(k.g1);
       k.g12 = k.g1.dot(k.g2);
       k.g22 = k.g2.dot(k.g2);
@@ -124,7 +115,7 @@ MembraneState MembraneMechanics::evaluate(const Eigen::Matrix3Xd& x) const {
     const Eigen::Vector3d t1 = r.weight0 * (A11 * k.g1 + A12 * k.g2);
     const Eigen::Vector3d t2 = r.weight0 * (A12 * k.g1 + A22 * k.g2);
     const auto& el = mesh_.elements[e];
-    for (int a = 0; a < 6; ++a) s.internal_force.col(el[a]) += dN_[q][0][a] * t1 + dN_[q][1][a] * t2;
+    for (int a = 0; a < 6; ++a) s.internal_force.col(el[a]) += p2_[q].dxi[a] * t1 + p2_[q].deta[a] * t2;
   });
   return s;
 }
@@ -160,20 +151,14 @@ std::vector<std::array<double, 2>> MembraneMechanics::principal_tensions(const E
 }
 
 AreaVolume area_and_volume(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x, int quadrature_degree) {
-  const auto& rule = quadrature::triangle_rule(quadrature_degree);
+  const auto p2 = mesh::P2Tabulation::of_degree(quadrature_degree);
   AreaVolume av;
   for (const auto& el : mesh.elements) {
-    for (int q = 0; q < rule.size(); ++q) {
-      const auto N = mesh::p2_shape(rule.points[q][1], rule.points[q][2]);
-      const auto dN = mesh::p2_shape_gradients(rule.points[q][1], rule.points[q][2]);
-      Eigen::Vector3d p = Eigen::Vector3d::Zero(), g1 = Eigen::Vector3d::Zero(), g2 = Eigen::Vector3d::Zero();
-      for (int a = 0; a < 6; ++a) {
-        p += N[a] * x.col(el[a]);
-        g1 += dN[0][a] * x.col(el[a]);
-        g2 += dN[1][a] * x.col(el[a]);
-      }
+    for (int q = 0; q < p2.size(); ++q) {
+      const Eigen::Vector3d p = p2.interpolate(x, el, q);
+      const auto [g1, g2] = p2.tangents(x, el, q);
       const Eigen::Vector3d n_da = g1.cross(g2);  // outward normal times the area element
-      const double w = 0.5 * rule.weights[q];
+      const double w = p2.weight(q);
       av.area += w * n_da.norm();
       av.volume += w * p.dot(n_da) / 3.0;
     }

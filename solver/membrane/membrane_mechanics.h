@@ -15,6 +15,7 @@
 
 #include "solver/membrane/membrane_law.h"
 #include "solver/mesh/mesh.h"
+#include "solver/mesh/p2_tabulation.h"
 
 namespace capsim::membrane {
 
@@ -76,7 +77,7 @@ class MembraneMechanics {
 
   const mesh::SurfaceMesh& mesh_;
   const MembraneLaw& law_;
-  std::vector<std::array<std::array<double, 6>, 2>> dN_;  // per rule point
+  mesh::P2Tabulation p2_;                                  // the rule's points
   std::vector<RefPoint> ref_;                              // element-major, per rule point
 };
 

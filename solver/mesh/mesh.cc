@@ -8,8 +8,7 @@
 #include <string>
 #include <unordered_map>
 
-#include "solver/mesh/p2_element.h"
-#include "solver/quadrature/triangle_rule.h"
+#include "solver/mesh/p2_tabulation.h"
 
 namespace capsim::mesh {
 namespace {
@@ -249,16 +248,11 @@ double min_node_spacing(const SurfaceMesh& m, const Eigen::Matrix3Xd& x) {
 }
 
 Eigen::Matrix3Xd node_normals(const SurfaceMesh& m, const Eigen::Matrix3Xd& x) {
-  static constexpr double local[6][2] = {{0, 0}, {1, 0}, {0, 1}, {0.5, 0}, {0.5, 0.5}, {0, 0.5}};
+  static const P2Tabulation nodes = P2Tabulation::at_nodes();
   Eigen::Matrix3Xd n = Eigen::Matrix3Xd::Zero(3, x.cols());
   for (const auto& el : m.elements)
     for (int k = 0; k < 6; ++k) {
-      const auto dN = p2_shape_gradients(local[k][0], local[k][1]);
-      Vec3 g1 = Vec3::Zero(), g2 = Vec3::Zero();
-      for (int a = 0; a < 6; ++a) {
-        g1 += dN[0][a] * x.col(el[a]);
-        g2 += dN[1][a] * x.col(el[a]);
-      }
+      const auto [g1, g2] = nodes.tangents(x, el, k);
       n.col(el[k]) += g1.cross(g2).normalized();
     }
   n.colwise().normalize();

@@ -169,7 +169,7 @@ const TriangleRule& triangle_rule(int degree) {
     case 6: return r6;
     default:
       throw std::invalid_argument("triangle_rule: degree " + std::to_string(degree) +
-                                  " is not available (choose 1, 2, 4, 5 or 6)");
+                                  " is not available (choose 1, 2, 4, 5 or 6; 1 and 2 serve the far-field tier only)");
   }
 }
 

@@ -10,39 +10,25 @@
 /// (q = load the fluids exert on the membrane, so the membrane pushes the fluid with −q; DESIGN.md §3).
 /// Identity for tests: on the unit sphere, a uniform q = f gives u = (16π/3) f, i.e. v − v∞ = −2f/(3Ca).
 ///
-/// Method:
-///  - Regular part: one triangle rule (degree 4/5/6) on every element; all quadrature points of the surface
-///    are laid out once per call as structure-of-arrays (x, y, z and w·|∂x/∂ξ × ∂x/∂η|·q), padded to the
-///    SIMD width with zero loads, and summed for all targets by kernel::sum_fast (or sum_plain).
-///  - Far-field tier (Options::far_degree > 0; off by default): the all-pairs sum above uses a COARSE rule
-///    (degree 1: centroid, or degree 2: 3 points) on every element instead. An element e is "far" from a
-///    target x0 when |x0 − c_e| > far_radius · ρ_e (c_e the mean of its 6 nodes, ρ_e their largest distance
-///    from c_e); for it the coarse rule is the final answer. Every other ("mid") element, and always the
-///    target's own elements and near-singular neighbours, gets one contiguous block "regular rule minus
-///    coarse rule" (the coarse points with negated weights) added per target, so after this step the sum is
-///    exactly the regular-rule sum on all non-far elements and the corrections below apply unchanged. The
-///    mid elements of a target are found with a uniform grid of element centroids (cell = ½ far_radius ·
-///    max ρ_e), rebuilt every call in O(N) because the geometry moves between calls; the mid blocks are
-///    laid out in the grid's cell order so that a target's blocks form a few contiguous runs.
-///    Accuracy: the coarse rule's relative error on an element at distance d is ~ (ρ_e/d)^(far_degree+1);
-///    summed over the surface the far-field error is ~ ρ · far_radius^(−far_degree), i.e. only O(h) at a
-///    fixed radius (the method itself converges at order ~3). Measured (tests/benchmarks/stokes_bench.cc,
-///    deformed surface, levels 2–4): degree 1 costs 25–100× the discretisation error at any radius; degree 2
-///    at radius 4 costs ~0.15× of it, and pays off (1.3×, one thread) only from level 4 on, because the
-///    singular correction and the mid blocks (~60 elements per target at radius 4) are a fixed cost.
-///  - Singular part: for each target node and each element containing it, the regular-rule contribution of
-///    that element is subtracted and replaced by a Duffy (collapsed-square) integral with the node at the
-///    apex on the exact P2 geometry: one sub-triangle for a corner node; for a mid-side node the two halves
-///    through the opposite vertex (DESIGN.md §3), each split again at the midpoint of its far edge (4
-///    sub-triangles with ~45° apex angles: error 3e-6 → 1e-9 at n = 10 on a curved level-0 element), an
-///    n × n Gauss-Legendre product rule on each (the s Jacobian cancels the 1/r singularity).
-///  - Near-singular part: elements sharing a vertex with an element that contains the target are close to
-///    it (h/2 for a mid-side node); their regular-rule contribution is replaced by a subdivided rule
-///    (Options::near_subdivision, near_degree). The neighbour lists come from connectivity only.
-///  - Mirror symmetry x3 → −x3: if positions and loads are symmetric (checked in O(N) with
-///    mesh.mirror_node, to a tolerance relative to the extent of x and the largest |q|), only the targets
-///    with x3 ≥ 0 are evaluated and u is mirrored to the others (u3 flips sign). Otherwise every target is
-///    evaluated. Options::symmetry forces either way.
+/// Method, in the order apply() runs its phases:
+///  1. Layout (source_layout.h): one triangle rule (degree 4/5/6) on every element; all quadrature points of
+///     the surface are laid out once per call as structure-of-arrays (x, y, z and w·|∂x/∂ξ × ∂x/∂η|·q),
+///     padded to the SIMD width with zero loads.
+///  2. Regular part: kernel::sum_fast (or sum_plain) sums them for all targets.
+///  3. Far-field tier (far_field.h; Options::far_degree > 0, off by default): the all-pairs sum of phase 2
+///     runs over a COARSE rule instead, and each target's near ("mid") elements are upgraded back to the
+///     regular rule, so the phases below apply unchanged.
+///  4. Singular part (singular_rules.h): for each target node and each element containing it, the
+///     regular-rule contribution of that element is subtracted and replaced by a Duffy (collapsed-square)
+///     integral with the node at the apex on the exact P2 geometry, an n × n Gauss-Legendre product rule on
+///     each sub-triangle (the s Jacobian cancels the 1/r singularity).
+///     Near-singular part (near_singular.h): elements sharing a vertex with an element that contains the
+///     target are close to it (h/2 for a mid-side node); their regular-rule contribution is replaced by a
+///     subdivided rule (Options::near_subdivision, near_degree).
+///  5. Mirror symmetry x3 → −x3: if positions and loads are symmetric (checked in O(N) with
+///     mesh.mirror_node, to a tolerance relative to the extent of x and the largest |q|), only the targets
+///     with x3 ≥ 0 are evaluated and u is mirrored to the others (u3 flips sign). Otherwise every target is
+///     evaluated. Options::symmetry forces either way.
 ///
 /// Contract:
 ///  - Cached from the constructor (depends only on connectivity and Options): element → nodes, node →
@@ -57,11 +43,18 @@
 ///    SingleLayer must not be used by two threads at once. It is internally OpenMP-parallel.
 ///  - far_degree = 0 gives bit for bit the result of the operator without the far-field tier.
 
+#include <array>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "solver/mesh/mesh.h"
+#include "solver/mesh/p2_tabulation.h"
+#include "solver/stokes/far_field.h"
+#include "solver/stokes/near_singular.h"
+#include "solver/stokes/singular_rules.h"
+#include "solver/stokes/source_layout.h"
 #include "solver/stokes/stokeslet.h"
 
 namespace capsim::stokes {
@@ -77,22 +70,32 @@ enum class Symmetry {
 enum class KernelChoice { Fast, Plain };
 
 /// @brief Options of the single-layer operator.
+///
+/// The case registry (solver/config/case_config.h) owns the user-facing keys numerics.regular_degree,
+/// duffy_order, far_degree and far_radius: CapsuleFlow always fills them from the case, so a run never uses
+/// the defaults below. They equal the registry's defaults (tests/solver/stokes checks it) so that a
+/// default-constructed operator (tests, benchmarks, `capsim bench`) is the operator of a default case. The
+/// ranges valid() accepts are what the operator can compute; the registry may restrict them further.
 struct SingleLayerOptions {
   int regular_degree = 4;      ///< triangle rule for regular elements: 4 (6 pts), 5 (7 pts), 6 (12 pts)
-  int duffy_order = 6;         ///< Gauss-Legendre points per direction of each Duffy square (≥ 1)
+  int duffy_order = 8;         ///< Gauss-Legendre points per direction of each Duffy square (2..64)
   /// Near-singular correction: elements that share a vertex with an element containing the target (but do
   /// not contain it) are re-integrated with `near_degree` on each of 4^near_subdivision sub-triangles
-  /// (0 = off). Without it the error at mid-side nodes (h/2 from such elements) is O(h).
+  /// (0 = off, at most 4). Without it the error at mid-side nodes (h/2 from such elements) is O(h).
   int near_subdivision = 1;
   int near_degree = 6;         ///< rule of the near-singular sub-triangles: 4, 5 or 6
-  /// Far-field tier (see the file comment): 0 = off (every element gets the regular rule for every target),
+  /// Far-field tier (far_field.h): 0 = off (every element gets the regular rule for every target),
   /// 1 = centroid rule, 2 = 3-point degree-2 rule on elements farther than far_radius · ρ_e from the target.
   int far_degree = 0;
-  double far_radius = 4.0;     ///< far when |x0 − c_e| > far_radius · ρ_e; must be > 1
+  double far_radius = 4.0;     ///< far when |x0 − c_e| > far_radius · ρ_e; finite and > 1 (ignored when off)
   Symmetry symmetry = Symmetry::Auto;
-  double symmetry_tol = 1e-10; ///< relative tolerance of the symmetry check
+  double symmetry_tol = 1e-10; ///< relative tolerance of the symmetry check (≥ 0)
   KernelChoice kernel = KernelChoice::Fast;
-  kernel::FastConfig fast{};   ///< tuning of the fast kernel
+  kernel::FastConfig fast{};   ///< tuning of the fast kernel (block 1..4)
+
+  /// @brief Whether the operator can be built with these options; if not and why is not null, *why names
+  /// the first offending option, its value and its range.
+  [[nodiscard]] bool valid(std::string* why = nullptr) const;
 };
 
 /// @brief Timing and size of the last apply() (seconds).
@@ -111,8 +114,7 @@ struct SingleLayerStats {
 /// @brief u(x0) = ∫_S J(x0, x)·q(x) dS(x) at every node (see the file comment).
 class SingleLayer {
  public:
-  /// @throws std::invalid_argument for an unknown rule degree, duffy_order < 1, far_degree ∉ {0, 1, 2},
-  /// far_radius ≤ 1, or an inconsistent mesh.
+  /// @throws std::invalid_argument if !options.valid() (with its reason) or for an inconsistent mesh.
   explicit SingleLayer(const mesh::SurfaceMesh& mesh, const SingleLayerOptions& options = {});
 
   /// @brief u at every node; x and q are 3 × num_nodes. u is resized as needed.
@@ -135,23 +137,14 @@ class SingleLayer {
   kernel::Sources build_sources(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q);
 
  private:
-  struct ShapeAt {
-    double w;                   // weight in the reference (ξ, η) measure (includes ½ or the Duffy Jacobian)
-    double n[6], dxi[6], deta[6];
-  };
-
-  static void layout(const std::vector<ShapeAt>& rule, const std::vector<std::array<int, 6>>& elements,
-                     const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, AlignedVector& px, AlignedVector& py,
-                     AlignedVector& pz, AlignedVector& pqx, AlignedVector& pqy, AlignedVector& pqz, int width);
-  // reg = SoA (x, y, z, qx, qy, qz) holding each element's regular-rule points at [s·stride, s·stride + nq),
-  // s = slot[e] (or e if slot is null).
-  // Lays out the points of `rule` on every element as the padded SoA sources of the all-pairs sum.
-  kernel::Sources layout_sources(const std::vector<ShapeAt>& rule, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q);
-  void singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, const std::vector<int>& targets,
-                           const double* const reg[6], int stride, const int* slot, Eigen::Matrix3Xd& u) const;
-  // Far-field tier: centroids, radii and grid of the current x, then the per-target mid blocks into u.
-  void build_centroid_grid(const Eigen::Matrix3Xd& x);
-  long long mid_correction(const std::vector<int>& targets, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& u);
+  // Constructor phase: connectivity copied from the mesh (checked), node → (element, local index).
+  void copy_connectivity(const mesh::SurfaceMesh& mesh);
+  // apply() phases (see the file comment).
+  void select_targets(const Eigen::Matrix3Xd& x, bool symmetric);
+  void regular_sum(const kernel::Sources& src, Eigen::Matrix3Xd& u);
+  long long far_field(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Eigen::Matrix3Xd& u);
+  void singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Eigen::Matrix3Xd& u) const;
+  void mirror(Eigen::Matrix3Xd& u) const;
 
   SingleLayerOptions opt_;
   int num_nodes_ = 0;
@@ -160,35 +153,23 @@ class SingleLayer {
   std::vector<int> node_offsets_;           // node → incidences CSR
   std::vector<int> inc_element_, inc_local_;
   std::vector<int> mirror_;                 // empty if the mesh has none
-  std::vector<ShapeAt> regular_;            // rule points
-  std::vector<ShapeAt> duffy_[6];           // per local node position
-  /// The same Duffy points as structure of arrays (vectorised loop): n[a], dxi[a], deta[a] for a = 0..5,
-  /// then w, each of length duffy_count_[l].
-  struct ShapeTable {
-    int count = 0;
-    AlignedVector n[6], dxi[6], deta[6], w;
-  };
-  ShapeTable duffy_soa_[6];
-  std::vector<ShapeAt> near_rule_;          // subdivided rule, then the regular rule negated (empty if off)
-  std::vector<int> near_offsets_, near_elements_;  // node → near-singular elements CSR
-  std::vector<ShapeAt> coarse_;             // far-field rule (empty if off)
-  std::vector<ShapeAt> mid_rule_;           // regular rule, then the coarse rule negated (empty if off)
-  // Work arrays (SoA sources, targets, results).
-  AlignedVector sx_, sy_, sz_, sqx_, sqy_, sqz_;
-  AlignedVector nx_, ny_, nz_, nqx_, nqy_, nqz_;  // near-rule points, element-major
+  std::vector<mesh::P2Point> regular_;      // rule points
+  PointTable duffy_[6];                     // Duffy rule per local node position (SoA)
+  std::vector<mesh::P2Point> near_rule_;    // subdivided rule, then the regular rule negated (empty if off)
+  NearSingularElements near_;               // node → near-singular elements (empty if off)
+  std::vector<mesh::P2Point> coarse_;       // far-field rule (empty if off)
+  std::vector<mesh::P2Point> mid_rule_;     // regular rule, then the coarse rule negated (empty if off)
+  // Work arrays of apply().
+  SourceArrays sources_;                    // all-pairs sources (regular or coarse rule)
+  SourceArrays near_points_;                // near-rule points, element-major
+  SourceArrays mid_points_;                 // mid-rule points, block per element in slot order (far tier)
   AlignedVector tx_, ty_, tz_, ux_, uy_, uz_;
-  AlignedVector mx_, my_, mz_, mqx_, mqy_, mqz_;  // mid-rule points, block per element in slot order (far tier)
-  // Far tier geometry of the current call: element centroids and radii, uniform grid (cell → elements CSR;
-  // slot j = position in cell order, element cell_elements_[j]), and per slot: element, centroid and
-  // (far_radius · ρ)².
-  std::vector<double> cx_, cy_, cz_, rho_;
-  std::vector<int> cell_offsets_, cell_elements_, cell_cursor_, cell_fill_, slot_;
-  std::vector<std::array<int, 6>> sorted_elements_;
-  std::vector<double> scx_, scy_, scz_, sreach2_;
-  double grid_lo_[3] = {0, 0, 0}, grid_cell_ = 1.0, far_reach_ = 0.0;
-  int grid_dim_[3] = {1, 1, 1};
-  std::vector<std::vector<int>> mark_;      // per-thread "already added for this target" stamps (per slot)
-  std::vector<std::vector<int>> slots_;     // per-thread mid slots of the current target
+  FarFieldGrid grid_;                       // far tier geometry of the current call
+  MidScratch mid_scratch_;                  // per-thread scratch of the far tier
+  // Where the singular correction finds each element's regular points: SoA, block stride, slot (or null).
+  const SourceArrays* regular_points_ = nullptr;
+  int regular_stride_ = 0;
+  const int* regular_slot_ = nullptr;
   std::vector<int> target_ids_;
   SingleLayerStats stats_;
 };

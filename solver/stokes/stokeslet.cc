@@ -149,10 +149,7 @@ inline void tile(const double* tx, const double* ty, const double* tz, const Sou
       const double dx = tx[l] - sx, dy = ty[l] - sy, dz = tz[l] - sz;
       const double r2 = dx * dx + dy * dy + dz * dz;
       const double y = r2 == 0.0 ? 0.0 : 1.0 / std::sqrt(r2);
-      const double s2 = (dx * qx + dy * qy + dz * qz) * y * y;
-      ax[l] += y * (qx + dx * s2);
-      ay[l] += y * (qy + dy * s2);
-      az[l] += y * (qz + dz * s2);
+      add_stokeslet(dx, dy, dz, qx, qy, qz, y, 1.0, ax[l], ay[l], az[l]);
     }
   }
   for (int l = 0; l < W; ++l) {
@@ -225,10 +222,7 @@ void sum_plain(const Targets& t, const Sources& s, const Result& u) {
       const double dx = x0 - sx[j], dy = y0 - sy[j], dz = z0 - sz[j];
       const double r2 = dx * dx + dy * dy + dz * dz;
       const double inv = r2 == 0.0 ? 0.0 : 1.0 / std::sqrt(r2);
-      const double sc = (dx * qx[j] + dy * qy[j] + dz * qz[j]) * inv * inv * inv;
-      ax += qx[j] * inv + dx * sc;
-      ay += qy[j] * inv + dy * sc;
-      az += qz[j] * inv + dz * sc;
+      add_stokeslet(dx, dy, dz, qx[j], qy[j], qz[j], inv, 1.0, ax, ay, az);
     }
     u.x[i] = ax;
     u.y[i] = ay;

@@ -16,7 +16,8 @@
 ///    The instruction set is chosen at compile time: AVX-512F, else AVX2+FMA, else a portable loop that
 ///    the compiler vectorises (see kernel_isa()).
 ///  - sum_plain: the reference, a straightforward `#pragma omp simd` loop over sources with 1/sqrt(r²)
-///    and a division. Used to verify the fast kernel and as the baseline of the benchmarks.
+///    and a division around add_stokeslet (below). Used to verify the fast kernel (tests) and as the
+///    baseline of the benchmarks; SingleLayerOptions::kernel selects it for the regular sum.
 /// Both overwrite u; both are OpenMP-parallel over targets (they are not meant to be called from inside a
 /// parallel region; if they are, they run on the calling thread).
 
@@ -87,10 +88,9 @@ enum class InvSqrt {
   Hybrid,   ///< alternate target vectors between the two (divider and FMA pipes busy at once; block ≥ 2)
 };
 
-/// @brief Tuning of the fast kernel (defaults = the measured best on the development machine).
-/// Measured on the development machine (AMD Zen 5, AVX-512, perf cycles:u, one thread, level-3 problem):
-/// cycles per interaction 1.71 (Newton, any block), 1.71 (sqrt+div), 1.53 (hybrid, block 2); the plain
-/// loop 1.88 when vectorised (-fno-math-errno), about 15 when not.
+/// @brief Tuning of the fast kernel. The defaults are the variant measured fastest on the development machine
+/// (AVX-512: hybrid, block 2); the per-variant cycle counts are in results/benchmarks.md ("Stokeslet
+/// kernel"); `capsim bench kernel` and build/bin/stokes_bench re-measure them.
 struct FastConfig {
   int block = 2;                        ///< target vectors per tile (1..4): register blocking
   InvSqrt inv_sqrt = InvSqrt::Hybrid;   ///< see InvSqrt
@@ -101,9 +101,6 @@ void sum_fast(const Targets& t, const Sources& s, const Result& u, const FastCon
 
 /// @brief The reference `omp simd` loop (sources in lanes). u is overwritten.
 void sum_plain(const Targets& t, const Sources& s, const Result& u);
-
-/// @brief Alias of sum_plain, the loop used to verify sum_fast.
-inline void verify(const Targets& t, const Sources& s, const Result& u) { sum_plain(t, s, u); }
 
 /// @brief Instruction set of sum_fast in this build: "avx512", "avx2" or "portable".
 const char* kernel_isa();
@@ -124,15 +121,19 @@ inline double rsqrt_arith(double x) {
   return y;
 }
 
-/// @brief J(x0, x)·q for one pair, r = x0 − x (zero if r = 0). Scalar reference, accumulates into out.
-inline void add_stokeslet(double rx, double ry, double rz, double qx, double qy, double qz, double out[3]) {
-  const double r2 = rx * rx + ry * ry + rz * rz;
-  if (r2 == 0.0) return;
-  const double inv = 1.0 / __builtin_sqrt(r2);
-  const double s = (rx * qx + ry * qy + rz * qz) * inv * inv * inv;
-  out[0] += qx * inv + rx * s;
-  out[1] += qy * inv + ry * s;
-  out[2] += qz * inv + rz * s;
+/// @brief The Stokeslet applied to a load, the one scalar definition used by every non-SIMD path:
+///     u += w · J(r)·q,   J(r)·q = (q + r (r·q)/r²) / r,   r = x0 − x,
+/// evaluated as (w·inv_r) (q + r ((r·q) inv_r inv_r)) with inv_r = 1/|r| supplied by the caller (each caller
+/// chooses how to compute it: 1/std::sqrt, rsqrt_arith; inv_r = 0 masks a pair at zero distance). This is the
+/// operation order of the SIMD tiles in stokeslet.cc, so the paths differ only in how 1/r is computed.
+/// T is double (inside `omp simd` loops, where it vectorises once inlined) or long double (test references).
+template <class T>
+inline void add_stokeslet(T rx, T ry, T rz, T qx, T qy, T qz, T inv_r, T w, T& ux, T& uy, T& uz) {
+  const T s = (rx * qx + ry * qy + rz * qz) * inv_r * inv_r;
+  const T f = w * inv_r;
+  ux += f * (qx + rx * s);
+  uy += f * (qy + ry * s);
+  uz += f * (qz + rz * s);
 }
 
 }  // namespace kernel

@@ -24,6 +24,7 @@ TEST(SphereMesh, CountsFollowTheIcosahedronSubdivision) {
 
 TEST(SphereMesh, NodesOnUnitSphereAndElementsOutward) {
   const SurfaceMesh m = make_sphere_mesh(3);
+  // Exact geometry: nodes are normalised, so |x| = 1 up to the rounding of a normalisation (a few ulps).
   for (int i = 0; i < m.num_nodes(); ++i) EXPECT_NEAR(m.nodes.col(i).norm(), 1.0, 1e-15);
   for (const auto& e : m.elements) {
     const Eigen::Vector3d n = (m.nodes.col(e[1]) - m.nodes.col(e[0])).cross(m.nodes.col(e[2]) - m.nodes.col(e[0]));
@@ -52,11 +53,13 @@ TEST_P(CapsuleMeshMaps, NodesOnSpheroidAndExactlyMirrorSymmetric) {
   const auto [r, map] = GetParam();
   const SurfaceMesh m = make_capsule_mesh(3, r, map);
   const auto [a, b] = spheroid_semi_axes(r);
+  // Exact identities (volume of the unit sphere, aspect ratio) up to the rounding of a cube root (a few ulps).
   EXPECT_NEAR(a * b * b, 1.0, 1e-15);
   EXPECT_NEAR(a / b, r, 1e-14);
   std::set<int> seen;
   for (int i = 0; i < m.num_nodes(); ++i) {
     const Eigen::Vector3d x = m.nodes.col(i);
+    // On the spheroid up to the rounding of the map (trigonometric functions of the node's angles).
     EXPECT_NEAR(x(0) * x(0) / (a * a) + (x(1) * x(1) + x(2) * x(2)) / (b * b), 1.0, 1e-13);
     const int j = m.mirror_node[i];
     ASSERT_GE(j, 0);

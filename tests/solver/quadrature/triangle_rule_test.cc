@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <numeric>
+#include <stdexcept>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -48,6 +50,28 @@ TEST(TriangleRule, UnknownDegreeThrows) {
   EXPECT_THROW(triangle_rule(0), std::invalid_argument);
   EXPECT_THROW(triangle_rule(3), std::invalid_argument);
   EXPECT_THROW(triangle_rule(7), std::invalid_argument);
+}
+
+// The message for an unknown degree lists every degree that exists (it once offered "4, 5 or 6" only,
+// though 1 and 2 exist for the far-field tier).
+TEST(TriangleRule, UnknownDegreeMessageListsEveryAvailableDegree) {
+  std::string message;
+  try {
+    triangle_rule(3);
+  } catch (const std::invalid_argument& e) {
+    message = e.what();
+  }
+  ASSERT_FALSE(message.empty());
+  const std::string choices = message.substr(message.find("choose"));
+  for (int d = 0; d <= 12; ++d) {
+    bool exists = true;
+    try {
+      triangle_rule(d);
+    } catch (const std::invalid_argument&) {
+      exists = false;
+    }
+    EXPECT_EQ(choices.find(std::to_string(d)) != std::string::npos, exists) << "degree " << d << ": " << message;
+  }
 }
 
 TEST(GaussLegendre, ExactToDegree2nMinus1) {

@@ -3,9 +3,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <string>
 #include <numbers>
 #include <vector>
 
+#include "solver/config/case_config.h"
 #include "solver/mesh/mesh.h"
 #include "solver/stokes/single_layer.h"
 
@@ -108,6 +111,7 @@ TEST(SingleLayer, SymmetricEvaluationEqualsFullEvaluation) {
   const double diff = (uf - us).cwiseAbs().maxCoeff() / scale;
   std::printf("  symmetric vs full: max diff / max |u| = %.2e (%d of %d targets)\n", diff,
               sym.last_stats().targets, m.num_nodes());
+  // The same integrals on mirrored data, summed in another order: round-off of sums of ~10⁴ O(1) terms.
   EXPECT_LT(diff, 1e-13);
   // u3 vanishes on the mirror plane in both.
   for (int i = 0; i < m.num_nodes(); ++i)
@@ -186,10 +190,13 @@ double rel_diff(const Matrix3Xd& u, const Matrix3Xd& ref) {
   return (u - ref).colwise().norm().maxCoeff() / ref.colwise().norm().maxCoeff();
 }
 
-// far_degree = 0 is the operator as it was before the tier existed. Reference values recorded from that code
-// (same scene, same options); on the development machine (AVX-512) the whole field is bit for bit equal. The
-// tolerance only admits the round-off differences of other instruction sets of the fast kernel.
-TEST(SingleLayerFarField, OffIsUnchanged) {
+// far_degree = 0 is the plain operator: no mid elements, the regular rule in the all-pairs sum, far_radius
+// ignored (same binary, same code path: equal bit for bit). Against the tier switched on with a radius that
+// makes every element "mid" (the coarse points added in the all-pairs sum and subtracted again in the mid
+// blocks, the regular rule everywhere): the same integral summed in another order, so equal to round-off —
+// 1e-13 relative to max |u| (sums of ~2000 terms of O(1)); the coarse rule's error, which a bug in the tier
+// would leave, is ~1e-2 here.
+TEST(SingleLayerFarField, OffIsTheRegularRuleEverywhere) {
   const auto m = mesh::make_sphere_mesh(2);
   Matrix3Xd x, q;
   deformed_scene(m, x, q);
@@ -197,19 +204,61 @@ TEST(SingleLayerFarField, OffIsUnchanged) {
   const Matrix3Xd u = op.apply(x, q);
   EXPECT_EQ(op.last_stats().mid_elements, 0);
   EXPECT_EQ(op.last_stats().sources, op.num_quadrature_points());
-  const double before[4][4] = {
-      {0, 7.6050273336130418, -0.21976077274394146, 1.6101051182456474},
-      {7, 7.1937104071523059, 2.4029348237712407, -0.72903047501876272},
-      {100, 6.8793363651989639, 3.5054207285609364, -1.6503892001527125},
-      {641, 7.9044812275935419, -2.3309808275189789, 1.0520832620371163},
-  };
-  for (const auto& r : before)
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(u(c, static_cast<int>(r[0])), r[c + 1], 1e-13) << "node " << r[0];
-  // far_radius is ignored when the tier is off.
   SingleLayerOptions other;
   other.far_radius = 2.5;
   SingleLayer op2(m, other);
   EXPECT_EQ((op2.apply(x, q) - u).cwiseAbs().maxCoeff(), 0.0);
+  for (const int degree : {1, 2}) {
+    SingleLayerOptions all_mid;
+    all_mid.far_degree = degree;
+    all_mid.far_radius = 1e6;
+    SingleLayer op3(m, all_mid);
+    const Matrix3Xd u3 = op3.apply(x, q);
+    EXPECT_EQ(op3.last_stats().mid_elements, static_cast<long long>(op3.last_stats().targets) * op3.num_elements());
+    const double diff = rel_diff(u3, u);
+    std::printf("  far_degree %d, every element mid: max rel diff to the tier off %.2e\n", degree, diff);
+    EXPECT_LT(diff, 1e-13) << "degree " << degree;
+  }
+}
+
+// The operator's defaults are those of the case registry: a default-constructed operator (tests,
+// benchmarks) is the operator of a default case. (Before issue 12, duffy_order was 6 here and 8 there.)
+TEST(SingleLayer, DefaultsAreTheCaseRegistrys) {
+  const SingleLayerOptions o;
+  const config::CaseConfig c;
+  EXPECT_EQ(o.regular_degree, c.regular_degree);
+  EXPECT_EQ(o.duffy_order, c.duffy_order);
+  EXPECT_EQ(o.far_degree, c.far_degree);
+  EXPECT_EQ(o.far_radius, c.far_radius);
+  EXPECT_TRUE(o.valid());
+}
+
+// valid() names the offending option; the constructor throws with that reason.
+TEST(SingleLayer, OptionsSayWhyTheyAreInvalid) {
+  SingleLayerOptions o;
+  std::string why;
+  o.duffy_order = 1;  // the registry's range is 2..64, and so is the operator's
+  EXPECT_FALSE(o.valid(&why));
+  EXPECT_NE(why.find("duffy_order"), std::string::npos) << why;
+  o = {};
+  o.duffy_order = 64;
+  EXPECT_TRUE(o.valid(&why));
+  o.near_degree = 2;
+  EXPECT_FALSE(o.valid(&why));
+  EXPECT_NE(why.find("near_degree"), std::string::npos) << why;
+  o = {};
+  o.fast.block = 5;
+  EXPECT_FALSE(o.valid(&why));
+  EXPECT_NE(why.find("block"), std::string::npos) << why;
+  o = {};
+  o.far_radius = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(o.valid(nullptr));
+  try {
+    SingleLayer(mesh::make_sphere_mesh(0), o);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("far_radius"), std::string::npos) << e.what();
+  }
 }
 
 // The coarse rule's relative error on a far element at distance d is ~ (ρ/d)^(k), k = far_degree + 1; summed
@@ -280,7 +329,7 @@ TEST(SingleLayerFarField, SymmetricEvaluationEqualsFullEvaluation) {
     EXPECT_GT(full.last_stats().mid_elements, 0);
     const double diff = rel_diff(us, uf);
     std::printf("  far_degree %d: symmetric vs full max diff / max |u| = %.2e\n", degree, diff);
-    EXPECT_LT(diff, 1e-13);
+    EXPECT_LT(diff, 1e-13);  // round-off of a reordered sum, as above
   }
 }
 

@@ -1,0 +1,34 @@
+#pragma once
+/// @file
+/// @brief The singular rules of the single-layer operator (DESIGN.md §3): for each of the six local node
+/// positions of a P2 element, a Duffy (collapsed-square) rule with that node at the apex on the reference
+/// triangle, and its structure-of-arrays table for the vectorised correction loop.
+///
+/// One sub-triangle for a corner node (the element itself); for a mid-side node the two halves through the
+/// opposite vertex, each split again at the midpoint of its far edge (4 sub-triangles with ~45° apex angles,
+/// on which the collapsed-square rule converges much faster than on the right-angled halves; see the
+/// Duffy test). On each sub-triangle (P, A, B), P the apex, (s, t) ∈ [0,1]² ↦ P + s (A − P) + s t (B − A)
+/// with Jacobian s |det(A − P, B − P)|: the s cancels the 1/r singularity, and an order × order
+/// Gauss-Legendre product rule integrates the rest.
+
+#include <vector>
+
+#include "solver/mesh/p2_tabulation.h"
+#include "solver/stokes/stokeslet.h"
+
+namespace capsim::stokes {
+
+/// @brief Duffy rule with local node `local` (0..5) at the apex, `order` Gauss-Legendre points per
+/// direction of each collapsed square. Weights in dξ dη (Duffy Jacobian included).
+std::vector<mesh::P2Point> duffy_rule(int local, int order);
+
+/// @brief A rule as structure of arrays: n[a], dxi[a], deta[a] (a = 0..5) and w, each of length count.
+struct PointTable {
+  int count = 0;
+  AlignedVector n[6], dxi[6], deta[6], w;
+};
+
+/// @brief The SoA table of a rule.
+PointTable make_point_table(const std::vector<mesh::P2Point>& rule);
+
+}  // namespace capsim::stokes

@@ -1,19 +1,23 @@
 #pragma once
 /// @file
 /// @brief Sub-commands of the `capsim` executable. Each takes the arguments after its own name and
-/// returns the process exit code: 0 success, 1 a run that ended badly (e.g. interrupted), 2 bad input
-/// (one clear message on stderr, nothing stored is changed).
+/// returns the process exit code, one of those of campaign/common/exit_codes.h.
 
 #include <string>
 #include <vector>
 
-namespace capsim::cli {
+#include "campaign/common/exit_codes.h"
 
-/// @brief Exit code for bad input (unknown key, wrong type, out-of-range value, missing/corrupt file).
-inline constexpr int kExitBadInput = 2;
+namespace capsim::cli {
 
 /// @brief `capsim run CASE.toml [--set key=value]... [--out DIR] [--threads N] [--resume] [--json]`.
 int run_command(const std::vector<std::string>& args);
+
+/// @brief `capsim _summary key=value...` (hidden; for test workers): the case summary
+/// (solver/driver/case_summary.h) with the given fields, printed as `capsim run --json` prints it, so a
+/// stand-in worker reports through the same code as the real one. Values that parse as JSON (numbers,
+/// true/false, null) are taken as such, others as strings. Exit 2 if a required field is missing.
+int summary_command(const std::vector<std::string>& args);
 
 /// @brief `capsim campaign run|status|...`.
 int campaign_command(const std::vector<std::string>& args);

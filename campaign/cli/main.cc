@@ -31,7 +31,7 @@ void print_usage() {
 int main(int argc, char** argv) {
   if (argc < 2) {
     print_usage();
-    return capsim::cli::kExitBadInput;
+    return capsim::kExitBadInput;
   }
   const std::string cmd = argv[1];
   const std::vector<std::string> rest(argv + 2, argv + argc);
@@ -45,14 +45,15 @@ int main(int argc, char** argv) {
   }
   try {
     if (cmd == "run") return capsim::cli::run_command(rest);
+    if (cmd == "_summary") return capsim::cli::summary_command(rest);
     if (cmd == "campaign") return capsim::cli::campaign_command(rest);
     if (cmd == "query") return capsim::cli::query_command(rest);
     if (cmd == "bench") return capsim::cli::bench_command(rest);
     if (cmd == "keys") return capsim::cli::keys_command(rest);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "capsim: error: %s\n", e.what());
-    return 1;
+    std::fprintf(stderr, "capsim: internal error: %s\n", e.what());
+    return capsim::kExitInternalError;
   }
   std::fprintf(stderr, "capsim: unknown command '%s' (see capsim --help)\n", cmd.c_str());
-  return capsim::cli::kExitBadInput;
+  return capsim::kExitBadInput;
 }

@@ -14,19 +14,14 @@
 #include "capsim/version.h"
 #include "solver/config/case_config.h"
 #include "solver/driver/case_driver.h"
+#include "solver/driver/case_summary.h"
 #include "solver/io/io_error.h"
-#include "solver/solver_version.h"
 
 namespace capsim::cli {
 namespace {
 
 std::atomic<bool> g_stop{false};
 extern "C" void on_stop_signal(int) { g_stop.store(true); }
-
-// Exit code of a run interrupted by SIGINT/SIGTERM after writing its checkpoint.
-constexpr int kExitInterrupted = 3;
-
-double json_number(double v) { return std::isfinite(v) ? v : std::nan(""); }
 
 }  // namespace
 
@@ -98,8 +93,8 @@ int run_command(const std::vector<std::string>& args) {
     std::fprintf(stderr, "capsim run: %s\n", e.what());
     return kExitBadInput;
   } catch (const io::IoError& e) {
-    std::fprintf(stderr, "capsim run: %s\n", e.what());
-    return kExitBadInput;
+    std::fprintf(stderr, "capsim run: cannot write the output: %s\n", e.what());
+    return kExitWriteFailed;
   }
 
   const auto& a = r.analysis;
@@ -117,40 +112,32 @@ int run_command(const std::vector<std::string>& args) {
                  r.wrinkle_final.load_roughness, r.wrinkle_max.load_roughness);
   }
   if (json) {
-    nlohmann::json j = {
-        {"status", r.status},
-        {"reason", r.reason},
-        {"capillary_number", config.capillary_number},
-        {"Ca", config.capillary_number},  // the name DESIGN.md §8 promises; capillary_number is the long one
-        {"aspect_ratio", config.aspect_ratio},
-        {"law", config.law},
-        {"skalak_C", config.skalak_C},
-        {"mesh_level", config.level},
-        {"min_D12", json_number(a.min_D12)},
-        {"max_tau_min", json_number(a.max_tau_min)},
-        {"mean_D12", json_number(a.mean_D12)},
-        {"period", json_number(a.period)},
-        {"regime", std::string(diagnostics::to_string(a.regime))},
-        {"converged", r.converged},
-        {"volume_drift", r.volume_drift},
-        {"compressed_area_fraction", json_number(r.wrinkle_final.compressed_area_fraction)},
-        {"load_roughness", json_number(r.wrinkle_final.load_roughness)},
-        {"max_compressed_area_fraction", json_number(r.wrinkle_max.compressed_area_fraction)},
-        {"max_load_roughness", json_number(r.wrinkle_max.load_roughness)},
-        {"steps", r.steps},
-        {"flow_evaluations", r.flow_evaluations},
-        {"dt", r.dt},
-        {"t_final", r.t_final},
-        {"wall_s", r.wall_s},
-        {"threads", omp_get_max_threads()},
-        {"case_file", std::filesystem::absolute(r.case_file).string()},
-        {"code_version", kGitCommit},
-        {"solver_version", kSolverVersion},
-    };
+    const nlohmann::json j = driver::CaseSummary::of(config, r).to_json();
     std::printf("%s\n", j.dump().c_str());
     std::fflush(stdout);
   }
-  return r.status == "interrupted" ? kExitInterrupted : 0;
+  return r.status == "interrupted" ? kExitInterrupted : kExitOutcome;
+}
+
+int summary_command(const std::vector<std::string>& args) {
+  nlohmann::json fields = nlohmann::json::object();
+  for (const auto& arg : args) {
+    const auto eq = arg.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      std::fprintf(stderr, "capsim _summary: expected key=value, got '%s'\n", arg.c_str());
+      return kExitBadInput;
+    }
+    const std::string key = arg.substr(0, eq), value = arg.substr(eq + 1);
+    auto parsed = nlohmann::json::parse(value, nullptr, /*allow_exceptions=*/false);
+    fields[key] = parsed.is_discarded() || parsed.is_string() || parsed.is_structured() ? nlohmann::json(value) : parsed;
+  }
+  try {
+    std::printf("%s\n", driver::CaseSummary::from_json(fields).to_json().dump().c_str());
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "capsim _summary: %s\n", e.what());
+    return kExitBadInput;
+  }
+  return kExitOutcome;
 }
 
 }  // namespace capsim::cli

@@ -26,6 +26,7 @@
 #include "campaign/scheduler/worker_process.h"
 #include "campaign/slurm/slurm.h"
 #include "campaign/store/store.h"
+#include "solver/io/atomic_file.h"
 
 namespace capsim::campaign {
 
@@ -340,15 +341,7 @@ ManagerLock::~ManagerLock() {
   if (fd_ >= 0) close(fd_);
 }
 
-void write_file_atomic(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out << text;
-    if (!out) throw std::runtime_error(tmp + ": cannot write");
-  }
-  fs::rename(tmp, path);
-}
+void write_file_atomic(const std::string& path, const std::string& text) { io::write_text_atomically(path, text); }
 
 std::string prepare_case_folder(const CaseRow& row, const std::string& runs_dir) {
   const std::string dir = row.out_dir.empty() ? runs_dir + "/" + row.case_id : row.out_dir;

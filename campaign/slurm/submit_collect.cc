@@ -13,6 +13,7 @@
 
 #include "campaign/analysis/transitions.h"
 #include "campaign/common/bad_input.h"
+#include "campaign/common/exit_codes.h"
 #include "campaign/grid/campaign_spec.h"
 #include "campaign/scheduler/worker_process.h"
 #include "campaign/slurm/slurm.h"
@@ -187,14 +188,14 @@ CollectCounts collect_pass(Store& store, std::optional<std::int64_t> campaign_id
         state = status = "failed";
         error = "Slurm array task " + job_task + ": worker exited 0 but " + kResultFile +
                 " is missing or not a valid result; stdout ends: " + tail_of(o.dir + "/stdout.log", 300);
-      } else if (code && *code == 3) {
+      } else if (code && *code == kExitInterrupted) {
         state = "interrupted";
         status = "queued";
         error = "interrupted in Slurm array task " + job_task + std::string(checkpoint ? " (checkpoint written; the next "
                                                                             "submit resumes it)" : "");
       } else if (code) {
         state = status = "failed";
-        error = "worker exited with code " + std::to_string(*code) + (*code == 2 ? " (bad input)" : "") +
+        error = "worker exited with code " + std::to_string(*code) + describe_exit_code(*code) +
                 (*code > 128 ? " (signal " + std::to_string(*code - 128) + ")" : "") + " in Slurm array task " +
                 job_task + "; stderr: " + tail_of(o.dir + "/stderr.log", 600);
       } else {

@@ -10,8 +10,10 @@
 #include <regex>
 
 #include "campaign/common/bad_input.h"
+#include "campaign/common/exit_codes.h"
 #include "capsim/schema_sql.h"
 #include "capsim/version.h"
+#include "solver/driver/case_summary.h"
 
 namespace capsim::campaign {
 
@@ -61,9 +63,8 @@ void verify_header(Db& db, bool& fresh, std::int64_t& file_version) {
 std::optional<nlohmann::json> parse_result_line(const std::string& line) {
   try {
     auto j = nlohmann::json::parse(line);
-    if (!j.is_object() || !j.contains("status") || !j["status"].is_string()) return std::nullopt;
-    std::string s = j["status"];
-    if (s != "done" && s != "unstable") return std::nullopt;
+    const std::string status = driver::CaseSummary::from_json(j).status;  // the worker's summary, checked
+    if (status != "done" && status != "unstable") return std::nullopt;
     return j;
   } catch (...) {
     return std::nullopt;
@@ -71,13 +72,7 @@ std::optional<nlohmann::json> parse_result_line(const std::string& line) {
 }
 
 namespace {
-SqlValue jnum(const nlohmann::json& j, const char* k) {
-  if (!j.contains(k) || !j[k].is_number()) return nullptr;
-  if (j[k].is_number_integer()) return j[k].get<std::int64_t>();
-  double x = j[k].get<double>();
-  if (!std::isfinite(x)) return nullptr;
-  return x;
-}
+SqlValue real_or_null(double x) { return std::isfinite(x) ? SqlValue{x} : SqlValue{nullptr}; }
 SqlValue jstr(const nlohmann::json& j, const char* k) {
   if (!j.contains(k) || !j[k].is_string()) return nullptr;
   return j[k].get<std::string>();
@@ -85,34 +80,35 @@ SqlValue jstr(const nlohmann::json& j, const char* k) {
 }  // namespace
 
 std::string result_mismatch(const nlohmann::json& j, const CaseParams& p) {
-  auto near = [](double a, double b) { return std::fabs(a - b) <= 1e-9 * std::max(1.0, std::fabs(b)); };
-  for (const char* k : {"capillary_number", "Ca"})
-    if (j.contains(k) && j[k].is_number() && !near(j[k].get<double>(), p.capillary_number()))
-      return std::string(k) + " " + j[k].dump();
-  if (j.contains("aspect_ratio") && j["aspect_ratio"].is_number() &&
-      !near(j["aspect_ratio"].get<double>(), p.aspect_ratio()))
-    return "aspect_ratio " + j["aspect_ratio"].dump();
-  if (j.contains("law") && j["law"].is_string() && j["law"].get<std::string>() != p.law())
-    return "law " + j["law"].dump();
-  if (j.contains("mesh_level") && j["mesh_level"].is_number_integer() && j["mesh_level"].get<int>() != p.mesh_level())
-    return "mesh_level " + j["mesh_level"].dump();
-  return "";
+  driver::CaseSummary s;
+  try {
+    s = driver::CaseSummary::from_json(j);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return driver::parameter_mismatch(s.parameters, {p.capillary_number(), p.aspect_ratio(), p.law(), p.skalak_C(),
+                                                   p.mesh_level()});
 }
 
 void insert_result(Db& db, const std::string& case_id, const nlohmann::json& j, const std::string& line) {
+  const driver::CaseSummary r = driver::CaseSummary::from_json(j);
   Stmt s(db, std::string("INSERT OR REPLACE INTO results(case_id,status,min_D12,max_tau_min,mean_D12,period,regime,"
                          "volume_drift,steps,dt,t_final,wall_s,code_version,raw_json,recorded_at) "
                          "VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,") + kNow + ")");
-  s.bind(1, case_id).bind(2, j["status"].get<std::string>()).bind(3, jnum(j, "min_D12"));
-  s.bind(4, jnum(j, "max_tau_min")).bind(5, jnum(j, "mean_D12")).bind(6, jnum(j, "period"));
-  s.bind(7, jstr(j, "regime")).bind(8, jnum(j, "volume_drift")).bind(9, jnum(j, "steps")).bind(10, jnum(j, "dt"));
-  s.bind(11, jnum(j, "t_final")).bind(12, jnum(j, "wall_s")).bind(13, jstr(j, "code_version")).bind(14, line);
+  s.bind(1, case_id).bind(2, r.status).bind(3, real_or_null(r.analysis.min_D12));
+  s.bind(4, real_or_null(r.analysis.max_tau_min)).bind(5, real_or_null(r.analysis.mean_D12));
+  s.bind(6, real_or_null(r.analysis.period)).bind(7, std::string(diagnostics::to_string(r.analysis.regime)));
+  s.bind(8, real_or_null(r.volume_drift)).bind(9, std::int64_t{r.steps}).bind(10, real_or_null(r.dt));
+  s.bind(11, real_or_null(r.t_final)).bind(12, real_or_null(r.wall_s));
+  s.bind(13, r.code_version.empty() ? SqlValue{nullptr} : SqlValue{r.code_version}).bind(14, line);
   s.step();
 }
 
 std::string result_reason(const nlohmann::json& j) {
-  for (const char* k : {"reason", "error", "message"})
-    if (j.contains(k) && j[k].is_string()) return j[k].get<std::string>();
+  try {
+    if (auto reason = driver::CaseSummary::from_json(j).reason; !reason.empty()) return reason;
+  } catch (const std::invalid_argument&) {
+  }
   return "blow-up reported by the solver";
 }
 
@@ -318,13 +314,13 @@ std::string Store::record_outcome(const std::string& case_id, std::int64_t attem
       status = outcome = (*j)["status"].get<std::string>();
       if (status == "unstable") error = result_reason(*j);
     }
-  } else if (out.signal == 0 && out.exit_code == 3 && parse_result_line(out.last_line) &&
+  } else if (out.signal == 0 && out.exit_code == kExitInterrupted && parse_result_line(out.last_line) &&
              result_mismatch(*parse_result_line(out.last_line), params).empty()) {
     // Interrupted after the result was printed: the result stands.
     j = parse_result_line(out.last_line);
     status = outcome = (*j)["status"].get<std::string>();
     if (status == "unstable") error = result_reason(*j);
-  } else if (out.signal == 0 && out.exit_code == 3) {
+  } else if (out.signal == 0 && out.exit_code == kExitInterrupted) {
     status = "queued";
     outcome = "interrupted";
     resumable = true;
@@ -332,8 +328,7 @@ std::string Store::record_outcome(const std::string& case_id, std::int64_t attem
   } else {
     status = outcome = "failed";
     error = out.signal ? "worker killed by signal " + std::to_string(out.signal) + " (" + strsignal(out.signal) + ")"
-                       : "worker exited with code " + std::to_string(out.exit_code) +
-                             (out.exit_code == 2 ? " (bad input)" : "");
+                       : "worker exited with code " + std::to_string(out.exit_code) + describe_exit_code(out.exit_code);
     if (!out.stderr_tail.empty()) error += "; stderr: " + out.stderr_tail;
   }
   Transaction t(*db_);

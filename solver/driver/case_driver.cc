@@ -3,15 +3,17 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <system_error>
 
-#include "capsim/version.h"
 #include "solver/diagnostics/material_point.h"
 #include "solver/diagnostics/time_series.h"
-#include "solver/diagnostics/wrinkle.h"
+#include "solver/driver/case_summary.h"
+#include "solver/driver/snapshot_fields.h"
 #include "solver/dynamics/capsule_flow.h"
 #include "solver/dynamics/time_stepper.h"
 #include "solver/io/case_file.h"
 #include "solver/io/checkpoint.h"
+#include "solver/io/io_error.h"
 #include "solver/membrane/membrane_mechanics.h"
 
 namespace capsim::driver {
@@ -23,6 +25,10 @@ using Clock = std::chrono::steady_clock;
 // extent of the capsule per unit time is no physical motion.
 constexpr double kMaxDisturbanceSpeed = 100.0;
 
+// Wrinkle indicators are sampled on this fixed time grid (units of 1/γ̇): often enough to catch a
+// transient; each sample costs one membrane evaluation and load solve (O(N), no boundary integral).
+constexpr double kWrinkleInterval = 1.0;
+
 std::vector<io::Attribute> case_attributes(const config::CaseConfig& c) {
   std::vector<io::Attribute> a;
   a.emplace_back("capillary_number", c.capillary_number);
@@ -32,17 +38,6 @@ std::vector<io::Attribute> case_attributes(const config::CaseConfig& c) {
   a.emplace_back("mesh_level", c.level);
   a.emplace_back("config_toml", c.to_toml());
   return a;
-}
-
-void write_snapshot(io::CaseWriter& writer, dynamics::CapsuleFlow& flow, const Eigen::Matrix3Xd& x, double t,
-                    long step) {
-  Eigen::Matrix3Xd v, q;
-  flow.velocity(x, v, &q);
-  const Eigen::Matrix3Xd n = mesh::node_normals(flow.mesh(), x);
-  const Eigen::VectorXd qn = (q.array() * n.array()).colwise().sum().transpose();
-  const io::NodeField fields[] = {io::NodeField::scalar("q_n", qn), io::NodeField::vector("q", q),
-                                  io::NodeField::vector("velocity", v)};
-  writer.write_snapshot(t, step, flow.mesh(), x, fields);
 }
 
 // Wrinkle indicators of state x (membrane and load only: no boundary integral, no flow evaluation counted).
@@ -62,207 +57,293 @@ std::optional<diagnostics::WrinkleIndicators> measure_wrinkle(dynamics::CapsuleF
   }
 }
 
-// Wrinkle indicators are sampled on this fixed time grid (units of 1/γ̇): often enough to catch a
-// transient; each sample costs one membrane evaluation and load solve (O(N), no boundary integral).
-constexpr double kWrinkleInterval = 1.0;
+// One run of one case, in the phases of the method. Each phase is a member function; run() calls them in
+// order. The state that a checkpoint carries (x, t, step, series, p_node, wrinkle_max) lives here, so a
+// resumed run continues exactly where the interrupted one stopped.
+class CaseRun {
+ public:
+  CaseRun(const config::CaseConfig& config, const RunOptions& options)
+      : config_(config), options_(options), wall0_(Clock::now()) {}
+
+  CaseResult run() {
+    set_up();
+    restore_or_start();
+    march();
+    finish();
+    output();
+    return r_;
+  }
+
+ private:
+  // --- Set up: output folder, mesh, membrane, load solver, boundary-integral operator, time step and the
+  // blow-up thresholds, all from the reference shape (a resumed run gets the same ones).
+  void set_up() {
+    config_.validate();
+    std::error_code ec;
+    std::filesystem::create_directories(options_.out_dir, ec);
+    if (ec) throw io::IoError(options_.out_dir, "cannot create the output folder: " + ec.message());
+    case_file_ = options_.out_dir / "case.h5";
+    checkpoint_file_ = options_.out_dir / "checkpoint.h5";
+    flow_.emplace(config_);
+    dt_ = config_.dt ? *config_.dt : dynamics::automatic_time_step(config_, mesh());
+    V0_ = membrane::area_and_volume(mesh(), flow_->reference()).volume;
+    h_min_ = mesh::min_node_spacing(mesh(), flow_->reference());
+    eps_ = 1e-9 * dt_;
+    integrator_ = dynamics::make_integrator(config_.scheme);
+    identity_ = config_.to_toml();
+  }
+
+  // --- Restore (from the checkpoint, with --resume) or start from the reference shape.
+  void restore_or_start() {
+    x_ = flow_->reference();
+    p_node_ = diagnostics::choose_material_point(mesh(), x_);
+    if (options_.resume && std::filesystem::exists(checkpoint_file_)) {
+      io::Checkpoint cp;
+      try {
+        cp = io::read_checkpoint(checkpoint_file_);
+      } catch (const io::IoError& e) {
+        throw config::ConfigError(std::string(e.what()) + " (remove it to start afresh)");  // bad input, not output
+      }
+      if (cp.strings["case"] != identity_ || cp.positions.cols() != mesh().num_nodes())
+        throw config::ConfigError(checkpoint_file_.string() + ": checkpoint belongs to another case (parameters differ)");
+      x_ = cp.positions;
+      t_ = cp.time;
+      step_ = cp.step;
+      series_ = cp.series;
+      p_node_ = static_cast<int>(cp.scalars["p_node"]);
+      wrinkle_max_.compressed_area_fraction = cp.scalars["max_compressed_area_fraction"];
+      wrinkle_max_.load_roughness = cp.scalars["max_load_roughness"];
+      writer_.emplace(io::CaseWriter::resume(case_file_, case_attributes(config_), series_));
+    } else {
+      writer_.emplace(case_file_, case_attributes(config_));
+    }
+    before_ = x_;
+    record_ = diagnostics::measure_step(mesh(), x_, t_, p_node_, 0.0);
+    first_step_ = step_;
+    // Every periodic action sits on a fixed grid of times (multiples of its interval), so a run resumed from
+    // a checkpoint checks, samples and saves at exactly the times an uninterrupted run does.
+    next_check_ = after(config_.check_interval);
+    next_checkpoint_ = after(config_.checkpoint_interval);
+    next_snapshot_ = at_or_after(config_.snapshot_interval);
+    next_sample_ = config_.sample_interval > 0 ? at_or_after(config_.sample_interval) : t_;
+    next_wrinkle_ = after(kWrinkleInterval);
+    convergence_.tol_D12 = convergence_.tol_tau_min = config_.period_tolerance;
+  }
+
+  // --- March in time until an interrupt, t_end, a blow-up or a converged periodic regime.
+  void march() {
+    while (true) {
+      if ((options_.stop_requested && options_.stop_requested->load()) ||
+          (options_.stop_after_steps > 0 && step_ - first_step_ >= options_.stop_after_steps)) {
+        save_checkpoint();
+        r_.status = "interrupted";
+        r_.reason = "stop requested at t = " + std::to_string(t_) + "; resume continues from the checkpoint";
+        return;
+      }
+      // Never step past the hard cap: the last step ends within one dt before t_end.
+      if (t_ + dt_ > config_.t_end + eps_) {
+        r_.status = "done";
+        return;
+      }
+      if (!advance()) return;
+      if (periodic_actions()) return;
+    }
+  }
+
+  // One step x_n → x_{n+1} and the blow-up tests. Each test judges a state by what is known of it: the
+  // velocity of x_n (the step's first stage), the displacement of the step, and x_{n+1} itself (finite,
+  // volume). A state is accepted only when it passed them, so the last good state never broke a tolerance.
+  // Returns false after a blow-up (status unstable, the last good state restored, checkpointed and written).
+  bool advance() {
+    const bool snapshot_due = t_ >= next_snapshot_ - eps_;
+    next_ = x_;
+    dynamics::StepInfo info;
+    std::string failure;
+    bool stepped = false;
+    try {
+      info = integrator_->step(*flow_, next_, dt_, snapshot_due ? &start_ : nullptr);
+      stepped = true;
+    } catch (const membrane::DegenerateSurface& e) {
+      failure = e.what();
+    } catch (const dynamics::StepRejected& e) {  // dt too large for this state: a numerical outcome too
+      failure = e.what();
+    }
+    if (stepped && (!std::isfinite(info.start.max_speed) || info.start.max_speed > kMaxDisturbanceSpeed)) {
+      // x_n itself moves at a runaway speed: the last good state is the one before it.
+      return blow_up("runaway velocity |v - v_inf| = " + std::to_string(info.start.max_speed), before_,
+                     step_ == first_step_ ? step_ : step_ - 1);
+    }
+    if (!failure.empty()) return blow_up(failure, x_, step_);
+    const double t_next = static_cast<double>(step_ + 1) * dt_;  // no drift from repeated additions
+    if (!next_.allFinite()) return blow_up("non-finite positions", x_, step_);
+    if (info.max_distortion > 0.5 * h_min_)
+      return blow_up("relative displacement of neighbouring nodes " + std::to_string(info.max_distortion) +
+                         " in one step exceeds h_min/2 = " + std::to_string(0.5 * h_min_),
+                     x_, step_);
+    diagnostics::StepRecord next_record = diagnostics::measure_step(mesh(), next_, t_next, p_node_, 0.0);
+    if (std::abs(next_record.volume - V0_) > config_.volume_tolerance * V0_)
+      return blow_up("volume changed by " + std::to_string(100.0 * (next_record.volume - V0_) / V0_) + "%", x_,
+                     step_);
+
+    // x_n passed every test: record it, then accept x_{n+1}.
+    if (snapshot_due) {
+      writer_->write_snapshot(t_, step_, mesh(), x_,
+                              snapshot_fields(mesh(), flow_->mechanics(), x_, start_, config_.membrane_degree));
+      next_snapshot_ += config_.snapshot_interval;
+    }
+    record_.tau_min = info.start.tau_min;
+    if (t_ >= next_sample_ - eps_) {
+      series_.push_back(record_);
+      writer_->append(record_);
+      next_sample_ += config_.sample_interval;
+    }
+    std::swap(before_, x_);
+    std::swap(x_, next_);
+    record_ = next_record;
+    ++step_;
+    t_ = t_next;
+    return true;
+  }
+
+  // A blow-up of the state at t_: the run ends unstable at @p good (step @p good_step), which becomes the
+  // state of the checkpoint and the last snapshot.
+  bool blow_up(const std::string& failure, const Eigen::Matrix3Xd& good, long good_step) {
+    r_.status = "unstable";
+    r_.reason = failure + " at t = " + std::to_string(t_);
+    if (&good != &x_) x_ = good;
+    step_ = good_step;
+    t_ = static_cast<double>(step_) * dt_;
+    save_checkpoint();
+    writer_->write_snapshot(t_, step_, mesh(), x_);
+    return false;
+  }
+
+  // The actions on their time grids after an accepted step: wrinkle sample, convergence check, checkpoint,
+  // progress. Returns true when the periodic regime has converged (the run is done).
+  bool periodic_actions() {
+    if (t_ >= next_wrinkle_ - eps_) {
+      next_wrinkle_ += kWrinkleInterval;
+      sample_wrinkle();
+    }
+    if (t_ >= next_check_ - eps_) {
+      next_check_ += config_.check_interval;
+      r_.analysis = diagnostics::analyse_periods(series_);
+      if (diagnostics::periodic_regime_converged(r_.analysis, convergence_)) {
+        r_.converged = true;
+        r_.status = "done";
+        return true;
+      }
+    }
+    if (t_ >= next_checkpoint_ - eps_) {
+      writer_->flush();
+      save_checkpoint();
+      next_checkpoint_ += config_.checkpoint_interval;
+    }
+    if (options_.progress && Clock::now() - last_progress_ > std::chrono::seconds(1)) {
+      last_progress_ = Clock::now();
+      options_.progress({t_, config_.t_end, step_, record_.D12, series_.empty() ? 0.0 : series_.tau_min.back(),
+                         std::chrono::duration<double>(Clock::now() - wall0_).count()});
+    }
+    return false;
+  }
+
+  // --- Finish: final wrinkle sample, period analysis, volume drift, counts and timings.
+  void finish() {
+    r_.wrinkle_final = sample_wrinkle();
+    r_.wrinkle_max = wrinkle_max_;
+    // The final analysis also classifies a shape that ended stationary to the period tolerance; during the
+    // march only a settled steady state may stop the run (diagnostics::PeriodOptions).
+    diagnostics::PeriodOptions final_analysis;
+    final_analysis.stationary_tolerance = config_.period_tolerance;
+    if (!series_.empty()) r_.analysis = diagnostics::analyse_periods(series_, final_analysis);
+    const double V = membrane::area_and_volume(mesh(), x_).volume;
+    r_.volume_drift = (V - V0_) / V0_;
+    r_.dt = dt_;
+    r_.steps = step_;
+    r_.t_final = t_;
+    r_.flow_evaluations = flow_->timings().evaluations;
+    r_.membrane_s = flow_->timings().membrane_s;
+    r_.load_s = flow_->timings().load_s;
+    r_.stokes_s = flow_->timings().stokes_s;
+    r_.case_file = case_file_;
+  }
+
+  // --- Output: the final checkpoint of a finished case and the summary as the case file's attributes.
+  void output() {
+    if (r_.status == "done") save_checkpoint();
+    r_.wall_s = std::chrono::duration<double>(Clock::now() - wall0_).count();
+    for (const auto& a : summary_attributes(CaseSummary::of(config_, r_))) writer_->set_attribute(a);
+    writer_->close();
+    r_.wall_s = std::chrono::duration<double>(Clock::now() - wall0_).count();
+  }
+
+  void save_checkpoint() {
+    io::Checkpoint cp;
+    cp.positions = x_;
+    cp.time = t_;
+    cp.step = step_;
+    cp.dt = dt_;
+    cp.series = series_;
+    cp.scalars["p_node"] = p_node_;
+    cp.scalars["max_compressed_area_fraction"] = wrinkle_max_.compressed_area_fraction;
+    cp.scalars["max_load_roughness"] = wrinkle_max_.load_roughness;
+    cp.strings["case"] = identity_;
+    io::write_checkpoint(checkpoint_file_, cp);
+  }
+
+  diagnostics::WrinkleIndicators sample_wrinkle() {
+    if (const auto w = measure_wrinkle(*flow_, x_, config_.membrane_degree)) {
+      wrinkle_max_.compressed_area_fraction = std::max(wrinkle_max_.compressed_area_fraction, w->compressed_area_fraction);
+      wrinkle_max_.load_roughness = std::max(wrinkle_max_.load_roughness, w->load_roughness);
+      return *w;
+    }
+    return {};
+  }
+
+  double at_or_after(double interval) const {
+    return interval > 0 ? std::ceil(t_ / interval - 1e-9) * interval : INFINITY;
+  }
+  double after(double interval) const {
+    return interval > 0 ? (std::floor(t_ / interval + 1e-9) + 1.0) * interval : INFINITY;
+  }
+  const mesh::SurfaceMesh& mesh() const { return flow_->mesh(); }
+
+  const config::CaseConfig& config_;
+  const RunOptions& options_;
+  const Clock::time_point wall0_;
+  Clock::time_point last_progress_ = Clock::now();
+
+  // Set up.
+  std::filesystem::path case_file_, checkpoint_file_;
+  std::optional<dynamics::CapsuleFlow> flow_;
+  std::unique_ptr<dynamics::TimeIntegrator> integrator_;
+  double dt_ = 0, V0_ = 0, h_min_ = 0, eps_ = 0;
+  std::string identity_;
+  diagnostics::ConvergenceOptions convergence_;
+  std::optional<io::CaseWriter> writer_;
+
+  // The state a checkpoint carries.
+  Eigen::Matrix3Xd x_;
+  double t_ = 0.0;
+  long step_ = 0;
+  diagnostics::TimeSeries series_;
+  int p_node_ = 0;
+  diagnostics::WrinkleIndicators wrinkle_max_;  // largest sampled values over the run
+
+  // The march.
+  long first_step_ = 0;
+  Eigen::Matrix3Xd before_, next_;  // x_{n-1} (the last good state if x_n runs away) and x_{n+1}
+  diagnostics::StepRecord record_;  // diagnostics of x_n, measured when it was accepted
+  dynamics::StartFields start_;     // v and q on x_n, kept from the first stage for a snapshot
+  double next_check_ = 0, next_checkpoint_ = 0, next_snapshot_ = 0, next_sample_ = 0, next_wrinkle_ = 0;
+
+  CaseResult r_;
+};
 
 }  // namespace
 
 CaseResult run_case(const config::CaseConfig& config, const RunOptions& options) {
-  const auto wall0 = Clock::now();
-  config.validate();
-  std::filesystem::create_directories(options.out_dir);
-  const auto case_file = options.out_dir / "case.h5";
-  const auto checkpoint_file = options.out_dir / "checkpoint.h5";
-
-  // --- Set up: mesh, membrane, load solver, boundary-integral operator.
-  dynamics::CapsuleFlow flow(config);
-  const auto& mesh = flow.mesh();
-  const double dt = config.dt ? *config.dt : dynamics::automatic_time_step(config, mesh);
-  const double V0 = membrane::area_and_volume(mesh, flow.reference()).volume;
-  Eigen::Matrix3Xd x = flow.reference();
-  double t = 0.0;
-  long step = 0;
-  diagnostics::TimeSeries series;
-  int p_node = diagnostics::choose_material_point(mesh, x);
-  const std::string identity = config.to_toml();
-  diagnostics::WrinkleIndicators wrinkle_max;  // largest sampled values over the run
-
-  std::optional<io::CaseWriter> writer;
-  if (options.resume && std::filesystem::exists(checkpoint_file)) {
-    io::Checkpoint cp = io::read_checkpoint(checkpoint_file);
-    if (cp.strings["case"] != identity || cp.positions.cols() != mesh.num_nodes())
-      throw config::ConfigError(checkpoint_file.string() + ": checkpoint belongs to another case (parameters differ)");
-    x = cp.positions;
-    t = cp.time;
-    step = cp.step;
-    series = cp.series;
-    p_node = static_cast<int>(cp.scalars["p_node"]);
-    wrinkle_max.compressed_area_fraction = cp.scalars["max_compressed_area_fraction"];
-    wrinkle_max.load_roughness = cp.scalars["max_load_roughness"];
-    writer.emplace(io::CaseWriter::resume(case_file, case_attributes(config), series));
-  } else {
-    writer.emplace(case_file, case_attributes(config));
-  }
-
-  auto save_checkpoint = [&](const Eigen::Matrix3Xd& state, double time, long steps) {
-    io::Checkpoint cp;
-    cp.positions = state;
-    cp.time = time;
-    cp.step = steps;
-    cp.dt = dt;
-    cp.series = series;
-    cp.scalars["p_node"] = p_node;
-    cp.scalars["max_compressed_area_fraction"] = wrinkle_max.compressed_area_fraction;
-    cp.scalars["max_load_roughness"] = wrinkle_max.load_roughness;
-    cp.strings["case"] = identity;
-    io::write_checkpoint(checkpoint_file, cp);
-  };
-
-  // --- March in time.
-  CaseResult r;
-  r.dt = dt;
-  const std::unique_ptr<dynamics::TimeIntegrator> integrator = dynamics::make_integrator(config.scheme);
-  Eigen::Matrix3Xd last_good;
-  const double h_min = mesh::min_node_spacing(mesh, x);
-  const double eps = 1e-9 * dt;
-  // Every periodic action sits on a fixed grid of times (multiples of its interval), so a run resumed from a
-  // checkpoint checks, samples and saves at exactly the times an uninterrupted run does.
-  auto at_or_after = [&](double interval) { return interval > 0 ? std::ceil(t / interval - 1e-9) * interval : INFINITY; };
-  auto after = [&](double interval) { return interval > 0 ? (std::floor(t / interval + 1e-9) + 1.0) * interval : INFINITY; };
-  double next_check = after(config.check_interval);
-  double next_checkpoint = after(config.checkpoint_interval);
-  double next_snapshot = at_or_after(config.snapshot_interval);
-  double next_sample = config.sample_interval > 0 ? at_or_after(config.sample_interval) : t;
-  double next_wrinkle = after(kWrinkleInterval);
-  auto sample_wrinkle = [&](const Eigen::Matrix3Xd& state) {
-    if (const auto w = measure_wrinkle(flow, state, config.membrane_degree)) {
-      wrinkle_max.compressed_area_fraction = std::max(wrinkle_max.compressed_area_fraction, w->compressed_area_fraction);
-      wrinkle_max.load_roughness = std::max(wrinkle_max.load_roughness, w->load_roughness);
-      return *w;
-    }
-    return diagnostics::WrinkleIndicators{};
-  };
-  const long first_step = step;
-  auto last_progress = Clock::now();
-  diagnostics::ConvergenceOptions conv;
-  conv.tol_D12 = conv.tol_tau_min = config.period_tolerance;
-  // During the march only a settled steady state may stop the run; the final analysis also classifies a
-  // shape that ended stationary to the period tolerance (diagnostics::PeriodOptions).
-  const diagnostics::PeriodOptions period_options;
-  diagnostics::PeriodOptions final_options;
-  final_options.stationary_tolerance = config.period_tolerance;
-
-  while (true) {
-    if ((options.stop_requested && options.stop_requested->load()) ||
-        (options.stop_after_steps > 0 && step - first_step >= options.stop_after_steps)) {
-      save_checkpoint(x, t, step);
-      r.status = "interrupted";
-      r.reason = "stop requested at t = " + std::to_string(t) + "; resume continues from the checkpoint";
-      break;
-    }
-    // Never step past the hard cap: the last step ends within one dt before t_end.
-    if (t + dt > config.t_end + eps) {
-      r.status = "done";
-      break;
-    }
-    if (t >= next_snapshot - eps) {
-      write_snapshot(*writer, flow, x, t, step);
-      next_snapshot += config.snapshot_interval;
-    }
-    diagnostics::StepRecord rec = diagnostics::measure_step(mesh, x, t, p_node, 0.0);
-    last_good = x;
-    dynamics::StepInfo info;
-    std::string failure;
-    try {
-      info = integrator->step(flow, x, dt);
-    } catch (const membrane::DegenerateSurface& e) {
-      failure = e.what();
-    }
-    if (failure.empty()) {
-      if (!x.allFinite()) failure = "non-finite positions";
-      else if (!std::isfinite(info.start.max_speed) || info.start.max_speed > kMaxDisturbanceSpeed)
-        failure = "runaway velocity |v - v_inf| = " + std::to_string(info.start.max_speed);
-      else if (info.max_distortion > 0.5 * h_min)
-        failure = "relative displacement of neighbouring nodes " + std::to_string(info.max_distortion) +
-                  " in one step exceeds h_min/2";
-      else if (std::abs(rec.volume - V0) > config.volume_tolerance * V0)
-        failure = "volume changed by " + std::to_string(100.0 * (rec.volume - V0) / V0) + "%";
-    }
-    if (!failure.empty()) {
-      x = last_good;
-      r.status = "unstable";
-      r.reason = failure + " at t = " + std::to_string(t);
-      save_checkpoint(x, t, step);
-      writer->write_snapshot(t, step, mesh, x);
-      break;
-    }
-    rec.tau_min = info.start.tau_min;
-    if (t >= next_sample - eps) {
-      series.push_back(rec);
-      writer->append(rec);
-      next_sample += config.sample_interval;
-    }
-    ++step;
-    t = step * dt;  // no drift from repeated additions
-
-    if (t >= next_wrinkle - eps) {
-      next_wrinkle += kWrinkleInterval;
-      sample_wrinkle(x);
-    }
-    if (t >= next_check - eps) {
-      next_check += config.check_interval;
-      r.analysis = diagnostics::analyse_periods(series, period_options);
-      if (diagnostics::periodic_regime_converged(r.analysis, conv)) {
-        r.converged = true;
-        r.status = "done";
-        break;
-      }
-    }
-    if (t >= next_checkpoint - eps) {
-      writer->flush();
-      save_checkpoint(x, t, step);
-      next_checkpoint += config.checkpoint_interval;
-    }
-    if (options.progress && Clock::now() - last_progress > std::chrono::seconds(1)) {
-      last_progress = Clock::now();
-      options.progress({t, config.t_end, step, rec.D12, rec.tau_min,
-                        std::chrono::duration<double>(Clock::now() - wall0).count()});
-    }
-  }
-
-  // --- Output: final analysis and summary attributes.
-  r.wrinkle_final = sample_wrinkle(x);
-  r.wrinkle_max = wrinkle_max;
-  if (!series.empty()) r.analysis = diagnostics::analyse_periods(series, final_options);
-  const double V = membrane::area_and_volume(mesh, x).volume;
-  r.volume_drift = (V - V0) / V0;
-  r.steps = step;
-  r.t_final = t;
-  r.flow_evaluations = flow.timings().evaluations;
-  r.membrane_s = flow.timings().membrane_s;
-  r.load_s = flow.timings().load_s;
-  r.stokes_s = flow.timings().stokes_s;
-  r.case_file = case_file;
-  if (r.status == "done") save_checkpoint(x, t, step);
-  writer->set_attribute({"status", r.status});
-  writer->set_attribute({"reason", r.reason});
-  writer->set_attribute({"regime", std::string(diagnostics::to_string(r.analysis.regime))});
-  writer->set_attribute({"min_D12", r.analysis.min_D12});
-  writer->set_attribute({"max_tau_min", r.analysis.max_tau_min});
-  writer->set_attribute({"mean_D12", r.analysis.mean_D12});
-  writer->set_attribute({"period", r.analysis.period});
-  writer->set_attribute({"volume_drift", r.volume_drift});
-  writer->set_attribute({"steps", r.steps});
-  writer->set_attribute({"dt", r.dt});
-  writer->set_attribute({"t_final", r.t_final});
-  writer->set_attribute({"compressed_area_fraction", r.wrinkle_final.compressed_area_fraction});
-  writer->set_attribute({"load_roughness", r.wrinkle_final.load_roughness});
-  writer->set_attribute({"max_compressed_area_fraction", r.wrinkle_max.compressed_area_fraction});
-  writer->set_attribute({"max_load_roughness", r.wrinkle_max.load_roughness});
-  writer->close();
-  r.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
-  return r;
+  return CaseRun(config, options).run();
 }
 
 }  // namespace capsim::driver

@@ -1,8 +1,17 @@
 #pragma once
 /// @file
-/// @brief One capsule case end to end, in the phases of the method: set up (mesh, law, operators), march
-/// in time (RK2 on dx/dt = v(x)) with per-step diagnostics, stop on a converged periodic regime, a blow-up,
-/// an interrupt or t_end, and output (HDF5 time series, snapshots, checkpoint, summary).
+/// @brief One capsule case end to end, in the phases of the method: set up (mesh, law, operators, time
+/// step, blow-up thresholds), restore from a checkpoint or start from the reference shape, march in time
+/// (the integrator of `time.scheme`, RKC by default, on dx/dt = v(x)) with per-step diagnostics and blow-up
+/// tests, stop on a converged periodic regime, a blow-up, an interrupt or t_end, finish (final analysis)
+/// and output (HDF5 time series, snapshots, checkpoint, the case summary as attributes).
+///
+/// Blow-up tests, each on the state it concerns: a collapsed element or a step the integrator refuses
+/// (dt too large for the stiffness), a runaway disturbance velocity of x_n, non-finite x_{n+1}, a step that
+/// moves neighbouring nodes apart by more than h_min/2 (h_min of the reference mesh, so a resumed run has
+/// the threshold of the uninterrupted one), a volume of x_{n+1} outside time.volume_tolerance. A state is
+/// accepted only after passing them: the last good state, kept in the checkpoint and the last snapshot,
+/// never broke a tolerance.
 
 #include <atomic>
 #include <filesystem>
@@ -33,8 +42,9 @@ struct RunOptions {
 };
 
 /// @brief Outcome of a case. `status`: "done" (t_end reached or periodic regime converged), "unstable"
-/// (numerical blow-up; `reason` says which test fired, the last good state is in the case file and the
-/// checkpoint), "interrupted" (stop requested; the checkpoint lets `resume` continue exactly).
+/// (numerical blow-up; `reason` says which test fired and at which t, the last good state is in the case
+/// file and the checkpoint, t_final and steps are its), "interrupted" (stop requested; the checkpoint lets
+/// `resume` continue exactly). CaseSummary (case_summary.h) is what a case reports of it.
 struct CaseResult {
   std::string status;
   std::string reason;
@@ -45,7 +55,7 @@ struct CaseResult {
   /// every time unit over the run (carried through checkpoints).
   diagnostics::WrinkleIndicators wrinkle_final, wrinkle_max;
   long steps = 0;
-  long flow_evaluations = 0;
+  long flow_evaluations = 0;        ///< velocity evaluations of the time steps (snapshots reuse a step's own)
   double dt = 0;
   double t_final = 0;
   double wall_s = 0;
@@ -54,8 +64,9 @@ struct CaseResult {
 };
 
 /// @brief Run one case.
-/// @throws config::ConfigError for bad input (e.g. a checkpoint of another case), io::IoError for output
-/// problems. Numerical blow-ups are results (status "unstable"), not exceptions.
+/// @throws config::ConfigError for bad input (e.g. a checkpoint of another case or a corrupt one),
+/// io::IoError when output cannot be written (folder not creatable, disk full, permissions). Numerical
+/// blow-ups are results (status "unstable"), not exceptions.
 CaseResult run_case(const config::CaseConfig& config, const RunOptions& options);
 
 }  // namespace capsim::driver

@@ -99,17 +99,8 @@ class CapsuleFlow {
 /// material). Measured limit of dt/(Ca h_min) (RK2, Skalak C = 1, shear flow, 5% initial stretch + 1e-6 h_min
 /// noise on every node, γ̇t = 3 or 1000 steps (600 at level 3), whichever first; blow-up = collapsed element,
 /// NaN, |Δx| > h_min/2, volume change > 5%; bisection: largest stable factor found, the next unstable one
-/// is 5% above it):
-///
-///   level  a/b    Ca = 0.01  0.03   0.1    0.3    1      3
-///   2      0.5         0.39  0.38   0.36   0.32   0.23   0.13
-///   2      1           0.38  0.38   0.34   0.32   0.25   0.17
-///   2      2           0.39  0.39   0.38   0.36   0.23   0.16
-///   3      1                 0.36
-///   3      2                               0.34
-///   3      0.5                                           0.13
-///
-/// All are bounded from below by 0.36/(1 + 0.75 Ca). The default factor 0.25 (time.dt_factor) keeps a
+/// is 5% above it; the table is in results/benchmarks.md, "RK2 stability limit"): all measurements are
+/// bounded from below by 0.36/(1 + 0.75 Ca). The default factor 0.25 (time.dt_factor) keeps a
 /// margin of ≥ 1.45 over every measurement; twice the automatic dt blows up (tested). At Ca = 0.3, a/b = 2
 /// dt = 0.3 Ca h_min (margin 1.2) already shows a spurious τmin excursion of 0.26 by γ̇t = 4.
 double automatic_time_step(const mesh::SurfaceMesh& mesh, double capillary_number, double factor);

@@ -10,9 +10,10 @@
 
 namespace capsim::dynamics {
 
-StepInfo Rk2Integrator::step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt) {
+StepInfo Rk2Integrator::step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt, StartFields* start) {
   StepInfo info;
-  info.start = flow.velocity(x, k1_);
+  info.start = flow.velocity(x, k1_, start ? &start->load : nullptr);
+  if (start) start->velocity = k1_;
   stage_ = x + dt * k1_;
   flow.velocity(stage_, k2_);
   stage_ = 0.5 * dt * (k1_ + k2_);
@@ -80,15 +81,16 @@ int RkcIntegrator::stages_for(double dt_rho, double damping) {
   return s;
 }
 
-StepInfo RkcIntegrator::step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt) {
+StepInfo RkcIntegrator::step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt, StartFields* start) {
   StepInfo info;
-  info.start = flow.velocity(x, f0_);
+  info.start = flow.velocity(x, f0_, start ? &start->load : nullptr);
+  if (start) start->velocity = f0_;
   const double rho = options_.safety * membrane_spectral_radius(flow.mesh(), x, flow.capillary_number(),
                                                                 info.start.tau_max);
   last_rho_ = rho;
   const int s = stages_for(dt * rho, options_.damping);
   if (s > options_.max_stages)
-    throw std::runtime_error("RKC: dt = " + std::to_string(dt) + " needs " + std::to_string(s) +
+    throw StepRejected("RKC: dt = " + std::to_string(dt) + " needs " + std::to_string(s) +
                              " stages (spectral radius " + std::to_string(rho) + "); lower time.dt");
 
   const RkcCoefficients k = rkc_coefficients(s, options_.damping);

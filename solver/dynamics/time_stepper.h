@@ -10,18 +10,14 @@
 ///    ε = 2/13). s is chosen per step from the spectral radius ρ(x_n) (membrane_spectral_radius) so that
 ///    dt ρ ≤ β(s): the cost per unit time grows like sqrt(ρ/dt) instead of ρ, and dt follows accuracy.
 ///
-/// Measured (Skalak C = 1, shear flow from the reference shape, γ̇t = 0–4; rk2 at its automatic dt, rkc at
-/// dt = 0.02 = time.dt_accuracy; "error" = max over t of the difference to rk2 at half its dt):
-///   case                         rk2 evals/γ̇t   rkc evals/γ̇t (mean s)   rkc error D12 / τmin (t ≥ 1)
-///   Ca 0.02, a/b 0.5, level 2    3040            500 (10)                 7e-5 / 1e-4 (1e-3 at t < 1)
-///   Ca 0.02, a/b 0.5, level 3    6051            700 (14)                 7e-5 / 3e-5 (vs rk2 itself)
-///   Ca 0.3,  a/b 2,   level 2     298            198 (4)                  6e-5 / 1.4e-4
-///   Ca 3,    a/b 2,   level 2      79            110 (2.8; same dt)       —
-/// Volume drift over γ̇t = 4 is unchanged (3e-5 at Ca 0.02; 1.1% at Ca 0.3, a/b 2, level 2: spatial).
-/// rk2 stays the cheaper scheme for Ca ≳ 1, where the stiffness is mild and rkc's conservative ρ bound
-/// makes it take 3 stages at the rk2 dt.
+/// rkc is the default: on the stiff small-Ca cases it needs several times fewer flow evaluations per unit
+/// time than rk2 at an error far below the period-to-period spread; rk2 stays the cheaper scheme for Ca ≳ 1,
+/// where the stiffness is mild and rkc's conservative ρ bound makes it take 3 stages at the rk2 dt. The
+/// measurements (evaluations per unit time, errors against rk2 at half its dt, volume drift) are in
+/// results/benchmarks.md, "Time integration".
 
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -44,21 +40,38 @@ struct StepInfo {
   int stages = 0;              ///< Runge–Kutta stages of this step
 };
 
+/// @brief An integrator refuses a step because dt is far too large for the stiffness of the state (RKC
+/// would need more than Options::max_stages stages). A numerical outcome like a blow-up: the driver reports
+/// the case as unstable with what() as its reason, not as an error.
+class StepRejected : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// @brief The velocity and membrane load on x_n, the state a step starts from (its first stage), for
+/// output that needs them (snapshots) without another flow evaluation.
+struct StartFields {
+  Eigen::Matrix3Xd velocity;  ///< v(x_n)
+  Eigen::Matrix3Xd load;      ///< q(x_n)
+};
+
 /// @brief One explicit step of dx/dt = v(x) with a given dt. Integrators keep only work arrays between
 /// steps (no history), so a run resumed from a checkpoint continues exactly.
 class TimeIntegrator {
  public:
   virtual ~TimeIntegrator() = default;
-  /// @brief Advance x by dt in place.
-  /// @throws membrane::DegenerateSurface if a stage meets a collapsed surface; x is then unchanged.
-  virtual StepInfo step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt) = 0;
+  /// @brief Advance x by dt in place. With @p start, also return v and q on the initial x (from the first
+  /// stage, which every scheme evaluates there: no extra flow evaluation).
+  /// @throws membrane::DegenerateSurface if a stage meets a collapsed surface; StepRejected if the scheme
+  /// cannot take dt. x is then unchanged (@p start is filled if the first stage succeeded).
+  virtual StepInfo step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt, StartFields* start = nullptr) = 0;
   [[nodiscard]] virtual std::string name() const = 0;
 };
 
 /// @brief Heun's method with preallocated stage arrays.
 class Rk2Integrator final : public TimeIntegrator {
  public:
-  StepInfo step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt) override;
+  StepInfo step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt, StartFields* start = nullptr) override;
   [[nodiscard]] std::string name() const override { return "rk2"; }
 
  private:
@@ -88,11 +101,11 @@ class RkcIntegrator final : public TimeIntegrator {
   struct Options {
     double damping = 2.0 / 13.0;  ///< ε of w0 = 1 + ε/s² (SSV's value: β(s) ≈ 0.653 s², strong damping)
     double safety = 1.25;         ///< ρ used = safety × membrane_spectral_radius (which is itself an upper fit)
-    int max_stages = 400;         ///< refuse (std::runtime_error) beyond: dt far too large for the problem
+    int max_stages = 400;         ///< refuse (StepRejected) beyond: dt far too large for the problem
   };
   RkcIntegrator() : RkcIntegrator(Options{}) {}
   explicit RkcIntegrator(Options options) : options_(options) {}
-  StepInfo step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt) override;
+  StepInfo step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt, StartFields* start = nullptr) override;
   [[nodiscard]] std::string name() const override { return "rkc"; }
 
   /// @brief β(s) = (1 + w0)/w1: the real stability interval [−β, 0] of the s-stage damped RKC.

@@ -8,6 +8,7 @@
 
 #include "capsim/version.h"
 #include "solver/io/hdf5_support.h"
+#include "solver/io/atomic_file.h"
 #include "solver/io/xdmf.h"
 
 namespace capsim::io {

@@ -5,10 +5,9 @@
 #include <span>
 #include <stdexcept>
 
-#include <fcntl.h>
-#include <unistd.h>
 
 #include "capsim/version.h"
+#include "solver/io/atomic_file.h"
 #include "solver/io/hdf5_support.h"
 
 namespace capsim::io {
@@ -71,13 +70,6 @@ std::uint64_t checksum(const Checkpoint& c) {
   return h.get();
 }
 
-void fsync_path(const std::filesystem::path& p, bool directory) {
-  const int fd = ::open(p.c_str(), directory ? O_RDONLY | O_DIRECTORY : O_RDONLY);
-  if (fd < 0) return;  // best effort for directories on exotic file systems
-  ::fsync(fd);
-  ::close(fd);
-}
-
 void write_contents(const std::filesystem::path& tmp, const std::filesystem::path& file, const Checkpoint& c) {
   h5::Handle fapl = h5::checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, file, "cannot create a property list");
   // The 1.10 file format checksums all metadata, so damage to the file structure is detected too.
@@ -120,20 +112,7 @@ void write_checkpoint(const std::filesystem::path& file, const Checkpoint& c) {
   for (const auto& [k, v] : c.strings)
     if (k.empty() || v.find('\0') != std::string::npos)
       throw std::invalid_argument("write_checkpoint: empty string key or NUL in string '" + k + "'");
-  std::filesystem::path tmp = file;
-  tmp += ".tmp-" + std::to_string(::getpid());
-  try {
-    write_contents(tmp, file, c);
-    fsync_path(tmp, false);
-    std::error_code ec;
-    std::filesystem::rename(tmp, file, ec);  // atomic replacement on POSIX
-    if (ec) throw IoError(file, "cannot rename " + tmp.string() + " into place: " + ec.message());
-    fsync_path(file.has_parent_path() ? file.parent_path() : std::filesystem::path("."), true);
-  } catch (...) {
-    std::error_code ec;
-    std::filesystem::remove(tmp, ec);
-    throw;
-  }
+  replace_file_atomically(file, [&](const std::filesystem::path& tmp) { write_contents(tmp, file, c); });
 }
 
 Checkpoint read_checkpoint(const std::filesystem::path& file) {

@@ -1,13 +1,6 @@
 #include "solver/io/xdmf.h"
 
-#include <cstdio>
-#include <fstream>
 #include <sstream>
-#include <system_error>
-
-#include <unistd.h>
-
-#include "solver/io/io_error.h"
 
 namespace capsim::io {
 
@@ -37,27 +30,6 @@ std::string xdmf_document(const std::string& h5_name, const XdmfTopologyRef& top
   }
   x << "  </Grid>\n </Domain>\n</Xdmf>\n";
   return x.str();
-}
-
-void write_text_atomically(const std::filesystem::path& file, const std::string& text) {
-  std::filesystem::path tmp = file;
-  tmp += ".tmp-" + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) {
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);
-      throw IoError(file, "cannot write (temporary file " + tmp.string() + ")");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw IoError(file, "cannot rename the temporary file into place: " + ec.message());
-  }
 }
 
 }  // namespace capsim::io

@@ -31,8 +31,4 @@ struct XdmfTopologyRef {
 std::string xdmf_document(const std::string& h5_name, const XdmfTopologyRef& topology,
                           const std::vector<XdmfSnapshot>& snapshots);
 
-/// @brief Write `text` to `file` atomically (temporary file + rename), so a reader never sees half of it.
-/// @throws IoError.
-void write_text_atomically(const std::filesystem::path& file, const std::string& text);
-
 }  // namespace capsim::io

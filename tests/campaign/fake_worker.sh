@@ -7,6 +7,10 @@
 #   a/b < 1: min_D12 = 0.02 + 2.0 |Ca - 0.03|   (< 0.05 for |Ca - 0.03| < 0.015)
 #   a/b >= 1: min_D12 = 0.02 + 0.5 |Ca - 0.225| (< 0.05 for |Ca - 0.225| < 0.06)
 #   max_tau_min = CaH - Ca with CaH = 0.70 / 0.35 (neo-hookean, a/b 0.5 / 2) and 2.5 / 1.4 (skalak)
+# The JSON line is printed by `capsim _summary` (the case summary of the real worker): the capsim binary is
+# $FAKE_CAPSIM, else the capsim that started this worker (campaign run), else the one next to the test
+# executable that did (build/tests/X -> build/bin/capsim), else the source tree's build/bin/capsim, else
+# capsim on PATH.
 # Faults, chosen by Ca (comma-separated lists, exact text as written in the case file):
 #   FAKE_CRASH_CA: SIGSEGV itself; FAKE_FAIL_CA: exit 1 with a message; FAKE_UNSTABLE_CA: status unstable;
 #   FAKE_BADINPUT_CA: exit 2. FAKE_LOG: append "done <DIR>" when a case completes.
@@ -25,9 +29,29 @@ while [ $# -gt 0 ]; do
   esac
 done
 [ -f "$case_file" ] || { echo "fake_worker: $case_file: no such file" >&2; exit 2; }
+find_capsim() {
+  [ -n "${FAKE_CAPSIM:-}" ] && { echo "$FAKE_CAPSIM"; return; }
+  local pid=$PPID exe
+  while [ -n "$pid" ] && [ "$pid" -gt 1 ]; do
+    exe=$(readlink "/proc/$pid/exe" 2>/dev/null)
+    case "$exe" in
+      */capsim) echo "$exe"; return ;;
+      */tests/*) for c in "${exe%/tests/*}/bin/capsim" "${exe%/tests/*}/capsim"; do
+                   [ -x "$c" ] && { echo "$c"; return; }
+                 done ;;
+    esac
+    pid=$(awk '{ print $4 }' "/proc/$pid/stat" 2>/dev/null)
+  done
+  local here; here=$(cd "$(dirname "$0")" && pwd)
+  [ -x "$here/../../build/bin/capsim" ] && { echo "$here/../../build/bin/capsim"; return; }
+  command -v capsim
+}
+capsim_bin=$(find_capsim)
+[ -x "$capsim_bin" ] || { echo "fake_worker: no capsim binary found (set FAKE_CAPSIM)" >&2; exit 1; }
 mkdir -p "$out"
 get() { awk -F' = ' -v k="$1" '$1 == k { gsub(/"/, "", $2); print $2; exit }' "$case_file"; }
 ca=$(get capillary_number); ar=$(get aspect_ratio); law=$(get law); level=$(get level); C=$(get skalak_C)
+C=${C:-1}
 in_list() { local v="$1" list="$2" x; IFS=',' read -ra xs <<< "$list"; for x in "${xs[@]}"; do [ "$x" = "$v" ] && return 0; done; return 1; }
 
 steps=${FAKE_STEPS:-4}
@@ -55,13 +79,19 @@ done
 trap '' TERM INT
 status=done
 in_list "$ca" "${FAKE_UNSTABLE_CA:-}" && status=unstable
-awk -v ca="$ca" -v ar="$ar" -v law="$law" -v level="$level" -v C="$C" -v status="$status" 'BEGIN {
+read -r d h <<< "$(awk -v ca="$ca" -v ar="$ar" -v law="$law" 'BEGIN {
   if (ar < 1) { d = 0.02 + 2.0 * (ca > 0.03 ? ca - 0.03 : 0.03 - ca); h = (law == "skalak") ? 2.5 : 0.70 }
   else        { d = 0.02 + 0.5 * (ca > 0.225 ? ca - 0.225 : 0.225 - ca); h = (law == "skalak") ? 1.4 : 0.35 }
-  printf "{\"status\":\"%s\",\"capillary_number\":%s,\"aspect_ratio\":%s,\"law\":\"%s\",\"skalak_C\":%s,", status, ca, ar, law, C
-  printf "\"mesh_level\":%s,\"min_D12\":%.17g,\"max_tau_min\":%.17g,\"mean_D12\":%.17g,\"period\":12.5,", level, d, h - ca, d + 0.1
-  printf "\"regime\":\"%s\",\"volume_drift\":1e-4,\"steps\":100,\"dt\":0.01,\"t_final\":25,\"wall_s\":0.2,", (d < 0.05 ? "swinging" : "tumbling")
-  printf "\"code_version\":\"fake\"%s}\n", (status == "unstable" ? ",\"reason\":\"NaN in velocity at t=3.2\"" : "")
-}'
+  printf "%.17g %.17g\n", d, h - ca
+}')"
+regime=$(awk -v d="$d" 'BEGIN { print (d < 0.05 ? "swinging" : "tumbling") }')
+mean=$(awk -v d="$d" 'BEGIN { printf "%.17g", d + 0.1 }')
+reason=""
+[ $status = unstable ] && reason="NaN in velocity at t=3.2"
+# The result line goes through the real summary code (capsim _summary), as `capsim run --json` prints it.
+"$capsim_bin" _summary status="$status" reason="$reason" capillary_number="$ca" aspect_ratio="$ar" law="$law" \
+  skalak_C="$C" mesh_level="$level" min_D12="$d" max_tau_min="$h" mean_D12="$mean" period=12.5 regime="$regime" \
+  volume_drift=1e-4 steps=100 flow_evaluations=200 dt=0.01 t_final=25 wall_s=0.2 threads=1 case_file="$out/case.h5" \
+  code_version=fake || exit 1
 [ -n "${FAKE_LOG:-}" ] && echo "done $out" >> "$FAKE_LOG"
 exit 0

@@ -2,6 +2,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "campaign/common/exit_codes.h"
+#include "campaign/grid/case_params.h"
+#include "campaign/store/store.h"
 #include "solver/io/checkpoint.h"
 #include "tests/campaign/test_util.h"
 
@@ -107,6 +110,74 @@ TEST(RunCommand, ResumeRefusesACheckpointOfAnotherCase) {
   const CmdResult r = sh(run(dir + "/case.toml --out " + dir + "/o --threads 1 --quiet --resume --set flow.capillary_number=0.5"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("checkpoint"), std::string::npos) << r.err;
+}
+
+// Defect 10: an output folder that cannot be created is not bad input: its own exit code, one line that
+// names the folder, no case run.
+TEST(RunCommand, UnwritableOutputFolderHasItsOwnExitCode) {
+  const std::string dir = fresh_dir("run_unwritable");
+  write_file(dir + "/case.toml", kTinyCase);
+  write_file(dir + "/plain_file", "");
+  const CmdResult r = sh(run(dir + "/case.toml --out " + dir + "/plain_file/out --threads 1 --quiet --json"));
+  EXPECT_EQ(r.code, kExitWriteFailed) << r.err;
+  EXPECT_NE(r.err.find("plain_file/out"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line: " << r.err;
+  EXPECT_EQ(r.out, "") << "no result line";
+}
+
+// The worker's line of `capsim run --json` is what the store reads back: parameters checked, results stored.
+TEST(RunCommand, StoreReadsTheJsonSummaryBack) {
+  const std::string dir = fresh_dir("run_store_reads");
+  write_file(dir + "/case.toml", kTinyCase);
+  const CmdResult r = sh(run(dir + "/case.toml --out " + dir + "/out --threads 1 --quiet --json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string line = r.out.substr(r.out.rfind('\n', r.out.size() - 2) + 1);
+  const auto j = parse_result_line(line);
+  ASSERT_TRUE(j.has_value()) << line;
+  CaseParams p = CaseParams::defaults();
+  p.set("capsule.aspect_ratio", 2.0);
+  p.set("capsule.law", std::string("neo-hookean"));
+  p.set("flow.capillary_number", 0.3);
+  p.set("mesh.level", std::int64_t{1});
+  EXPECT_EQ(result_mismatch(*j, p), "");
+  p.set("flow.capillary_number", 0.5);
+  EXPECT_EQ(result_mismatch(*j, p), "capillary_number 0.3");
+}
+
+// Defect 7: a result of another skalak_C does not belong to a Skalak case (it was accepted).
+TEST(RunCommand, ResultOfAnotherSkalakCIsRejected) {
+  CaseParams p = CaseParams::defaults();
+  p.set("capsule.law", std::string("skalak"));
+  p.set("capsule.skalak_C", 1.0);
+  const nlohmann::json reported = {{"status", "done"},           {"capillary_number", p.capillary_number()},
+                                   {"aspect_ratio", p.aspect_ratio()}, {"law", "skalak"},
+                                   {"skalak_C", 2.0},                  {"mesh_level", p.mesh_level()}};
+  const std::string line = reported.dump();
+  const auto j = parse_result_line(line);
+  ASSERT_TRUE(j.has_value()) << line;
+  EXPECT_NE(result_mismatch(*j, p), "") << "skalak_C 2 reported for a case with skalak_C 1";
+  nlohmann::json same = *j;
+  same["skalak_C"] = 1.0;
+  EXPECT_EQ(result_mismatch(same, p), "");
+  // For the neo-Hookean law skalak_C is not a parameter of the case (nor of its identity).
+  p.set("capsule.law", std::string("neo-hookean"));
+  nlohmann::json nh = *j;
+  nh["law"] = "neo-hookean";
+  EXPECT_EQ(result_mismatch(nh, p), "");
+}
+
+// The hidden `capsim _summary` (test workers) prints the summary of the given fields with every contract key.
+TEST(RunCommand, SummaryCommandPrintsTheCompleteSummary) {
+  const CmdResult r = sh(exe() + " _summary status=done capillary_number=0.3 aspect_ratio=2 law=skalak skalak_C=1 "
+                                 "mesh_level=2 min_D12=0.25 code_version=fake");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = last_json_line(r.out);
+  EXPECT_EQ(j["min_D12"], 0.25);
+  EXPECT_EQ(j["Ca"], 0.3);
+  EXPECT_EQ(j["law"], "skalak");
+  EXPECT_TRUE(j["period"].is_null());
+  EXPECT_TRUE(j.contains("flow_evaluations"));
+  EXPECT_EQ(sh(exe() + " _summary status=done law=skalak").code, kExitBadInput) << "parameters are required";
 }
 
 }  // namespace

@@ -9,6 +9,10 @@
 #include <gtest/gtest.h>
 
 #include "solver/io/case_file.h"
+#include "solver/io/checkpoint.h"
+#include "solver/io/io_error.h"
+#include "solver/membrane/membrane_mechanics.h"
+#include "solver/mesh/mesh.h"
 
 namespace capsim::driver {
 namespace {
@@ -112,6 +116,124 @@ TEST(CaseDriver, BlowUpIsRecordedNotThrown) {
   const auto contents = io::read_case_file(dir / "case.h5");
   for (double d : contents.series.D12) EXPECT_TRUE(std::isfinite(d));
   EXPECT_GE(contents.num_snapshots, 1) << "the last good state is written";
+}
+
+// An explicit scheme beyond its stability limit: the instability grows from round-off over some tens of
+// steps, so a run can be interrupted and resumed on the way.
+config::CaseConfig growing_instability() {
+  config::CaseConfig c;
+  c.aspect_ratio = 2.0;
+  c.level = 1;
+  c.capillary_number = 0.05;
+  c.scheme = "rk2";
+  c.dt_factor = 0.6;  // 2.4 times the automatic rk2 dt; twice it already blows up (time_stepper_test)
+  c.t_end = 20.0;
+  c.checkpoint_interval = 0.0;
+  return c;
+}
+
+// Defect 1: the blow-up thresholds come from the reference mesh, so a resumed run fires the same test at
+// the same step as the uninterrupted one (it took h_min from the restored, deformed positions).
+TEST(CaseDriver, ResumedRunBlowsUpAsTheUninterruptedRun) {
+  const config::CaseConfig c = growing_instability();
+  const CaseResult full = run_case(c, quiet_in(scratch("resume_blowup_full")));
+  ASSERT_EQ(full.status, "unstable") << "the case must blow up for this test to mean anything";
+  ASSERT_GT(full.steps, 4) << full.reason;
+  std::printf("uninterrupted: %s after %ld steps\n", full.reason.c_str(), full.steps);
+  for (long k : {full.steps / 2, full.steps - 2}) {
+    const auto dir = scratch("resume_blowup_" + std::to_string(k));
+    RunOptions o = quiet_in(dir);
+    o.stop_after_steps = k;
+    ASSERT_EQ(run_case(c, o).status, "interrupted");
+    o.stop_after_steps = 0;
+    o.resume = true;
+    const CaseResult resumed = run_case(c, o);
+    EXPECT_EQ(resumed.status, full.status) << "resumed after " << k << " steps";
+    EXPECT_EQ(resumed.reason, full.reason) << "resumed after " << k << " steps";
+    EXPECT_EQ(resumed.steps, full.steps) << "resumed after " << k << " steps";
+  }
+}
+
+double volume_of(const config::CaseConfig& c, const Eigen::Matrix3Xd& x) {
+  const auto mesh = mesh::make_capsule_mesh(c.level, c.aspect_ratio, mesh::parse_spheroid_map(c.spheroid_map));
+  return membrane::area_and_volume(mesh, x).volume;
+}
+
+// Defect 2: the volume test judges the state after the step, so the last good state (checkpoint, last
+// snapshot, t_final) keeps the tolerance; it used to be the first state that broke it.
+TEST(CaseDriver, LastGoodStateKeepsTheVolumeTolerance) {
+  config::CaseConfig c;
+  c.aspect_ratio = 2.0;
+  c.capillary_number = 0.9;
+  c.level = 1;
+  c.t_end = 4.0;
+  c.volume_correction = false;  // level 1 then leaks > 1e-3 of the volume by t = 4 (VolumeCorrectionConservesVolume)
+  c.volume_tolerance = 2e-4;
+  const auto dir = scratch("volume_tolerance");
+  const CaseResult r = run_case(c, quiet_in(dir));
+  ASSERT_EQ(r.status, "unstable");
+  EXPECT_NE(r.reason.find("volume"), std::string::npos) << r.reason;
+  const double V0 = volume_of(c, mesh::make_capsule_mesh(c.level, c.aspect_ratio).nodes);
+  const auto cp = io::read_checkpoint(dir / "checkpoint.h5");
+  EXPECT_LE(std::abs(volume_of(c, cp.positions) - V0), c.volume_tolerance * V0) << "the last good state broke it";
+  EXPECT_LE(std::abs(r.volume_drift), c.volume_tolerance);
+  EXPECT_DOUBLE_EQ(cp.time, r.t_final);
+}
+
+// Defect 4: a snapshot reuses the velocity and load of the step's first stage; a case with snapshots
+// reports the same flow evaluations and the same time series as without.
+TEST(CaseDriver, SnapshotsDoNotChangeTheRun) {
+  config::CaseConfig c;
+  c.aspect_ratio = 2.0;
+  c.capillary_number = 0.3;
+  c.level = 1;
+  c.t_end = 1.0;
+  const auto plain_dir = scratch("snapshots_off"), snap_dir = scratch("snapshots_on");
+  const CaseResult plain = run_case(c, quiet_in(plain_dir));
+  c.snapshot_interval = 0.25;
+  const CaseResult snap = run_case(c, quiet_in(snap_dir));
+  ASSERT_EQ(plain.status, "done");
+  ASSERT_EQ(snap.status, "done");
+  EXPECT_EQ(snap.flow_evaluations, plain.flow_evaluations);
+  const auto a = io::read_case_file(plain_dir / "case.h5"), b = io::read_case_file(snap_dir / "case.h5");
+  EXPECT_TRUE(a.series == b.series) << "the time series differ";
+  EXPECT_EQ(b.num_snapshots, 4);  // t = 0, 0.25, 0.5, 0.75 (the run ends within one dt before t = 1)
+}
+
+// Defect 5: a step RKC refuses (more than max_stages stages) is a numerical outcome with its reason, as a
+// blow-up is, not an exception that ends the process.
+TEST(CaseDriver, RefusedRkcStepIsAnUnstableOutcome) {
+  config::CaseConfig c;
+  c.aspect_ratio = 2.0;
+  c.capillary_number = 0.05;
+  c.level = 1;
+  c.scheme = "rkc";
+  c.dt = 500.0;  // dt ρ ≈ 3e5 at level 1 and Ca 0.05: about 700 stages, beyond the 400 allowed
+  c.t_end = 1000.0;
+  const auto dir = scratch("rkc_refused");
+  CaseResult r;
+  ASSERT_NO_THROW(r = run_case(c, quiet_in(dir)));
+  EXPECT_EQ(r.status, "unstable");
+  EXPECT_NE(r.reason.find("stages"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.steps, 0);
+  EXPECT_TRUE(std::filesystem::exists(dir / "checkpoint.h5"));
+}
+
+// Defect 10: an output folder that cannot be created is an output error naming the folder.
+TEST(CaseDriver, OutputFolderThatCannotBeCreatedIsAnIoError) {
+  const auto dir = scratch("not_a_folder");
+  { std::FILE* f = std::fopen((dir / "file").c_str(), "w"); std::fclose(f); }
+  config::CaseConfig c;
+  c.level = 1;
+  c.t_end = 0.1;
+  try {
+    run_case(c, quiet_in(dir / "file" / "out"));
+    FAIL() << "no exception";
+  } catch (const io::IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("file/out"), std::string::npos) << e.what();
+  } catch (const std::exception& e) {
+    FAIL() << "not an io::IoError: " << e.what();
+  }
 }
 
 }  // namespace

@@ -188,5 +188,40 @@ TEST(Rkc, StableWhereRk2BlowsUpAndAgreesWithIt) {
   EXPECT_LT(3 * evaluations_rkc, evaluations_rk2) << "RKC must need far fewer flow evaluations";
 }
 
+// The first stage's v and q are those of a plain evaluation on x_n (snapshots use them instead of one of
+// their own), for both schemes.
+TEST(Integrators, StartFieldsAreTheFieldsOfTheInitialState) {
+  CapsuleFlow flow(make_case(1, 0.3, 2.0));
+  const Eigen::Matrix3Xd x0 = perturbed_reference(flow);
+  Eigen::Matrix3Xd v, q;
+  flow.velocity(x0, v, &q);
+  for (const char* scheme : {"rk2", "rkc"}) {
+    auto integrator = make_integrator(scheme);
+    Eigen::Matrix3Xd x = x0;
+    StartFields start;
+    integrator->step(flow, x, 0.01, &start);
+    EXPECT_TRUE(start.velocity == v) << scheme;
+    EXPECT_TRUE(start.load == q) << scheme;
+    EXPECT_FALSE(x == x0) << scheme;
+  }
+}
+
+// A dt RKC cannot take is a StepRejected (the driver reports it as unstable), and x is left as it was.
+TEST(Rkc, RefusesTooManyStagesWithStepRejected) {
+  CapsuleFlow flow(make_case(1, 0.05, 2.0));
+  RkcIntegrator::Options o;
+  o.max_stages = 10;
+  RkcIntegrator rkc(o);
+  Eigen::Matrix3Xd x = flow.reference();
+  const Eigen::Matrix3Xd x0 = x;
+  try {
+    rkc.step(flow, x, 10.0);
+    FAIL() << "no exception";
+  } catch (const StepRejected& e) {
+    EXPECT_NE(std::string(e.what()).find("stages"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(x == x0);
+}
+
 }  // namespace
 }  // namespace capsim::dynamics

@@ -1,0 +1,122 @@
+// The case summary: one serialisation for the JSON line, the case file's attributes and the readers.
+#include "solver/driver/case_summary.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "solver/driver/case_driver.h"
+#include "solver/io/case_file.h"
+
+namespace capsim::driver {
+namespace {
+
+CaseSummary example() {
+  CaseSummary s;
+  s.status = "unstable";
+  s.reason = "volume changed by 5% at t = 3";
+  s.parameters = {0.3, 2.0, "skalak", 1.5, 2};
+  s.analysis.regime = diagnostics::Regime::swinging;
+  s.analysis.min_D12 = 0.21;
+  s.analysis.max_tau_min = -0.04;
+  s.analysis.mean_D12 = 0.3;  // period stays NaN: no complete period
+  s.converged = false;
+  s.volume_drift = -1e-4;
+  s.wrinkle_final = {0.1, 0.2};
+  s.wrinkle_max = {0.3, 0.4};
+  s.steps = 1234;
+  s.flow_evaluations = 5678;
+  s.dt = 0.02;
+  s.t_final = 24.68;
+  s.wall_s = 9.5;
+  s.threads = 2;
+  s.case_file = "/tmp/x/case.h5";
+  s.code_version = "abc";
+  s.solver_version = "2";
+  return s;
+}
+
+TEST(CaseSummary, JsonRoundTripKeepsEveryField) {
+  const CaseSummary s = example();
+  const nlohmann::json j = s.to_json();
+  EXPECT_TRUE(j["period"].is_null()) << "NaN is null in JSON";
+  EXPECT_EQ(j["Ca"], j["capillary_number"]);
+  const CaseSummary t = CaseSummary::from_json(nlohmann::json::parse(j.dump()));
+  EXPECT_EQ(t.to_json(), j);
+  EXPECT_TRUE(std::isnan(t.analysis.period));
+  EXPECT_EQ(t.analysis.regime, diagnostics::Regime::swinging);
+  EXPECT_EQ(t.steps, 1234);
+  EXPECT_EQ(t.wrinkle_max.load_roughness, 0.4);
+}
+
+// The keys DESIGN.md §8 and the scripts rely on.
+TEST(CaseSummary, JsonHasTheContractKeys) {
+  const nlohmann::json j = example().to_json();
+  for (const char* key : {"status", "reason", "Ca", "capillary_number", "aspect_ratio", "law", "skalak_C",
+                          "mesh_level", "min_D12", "max_tau_min", "mean_D12", "period", "regime", "converged",
+                          "volume_drift", "compressed_area_fraction", "load_roughness", "max_compressed_area_fraction",
+                          "max_load_roughness", "steps", "flow_evaluations", "dt", "t_final", "wall_s", "threads",
+                          "case_file", "code_version", "solver_version"})
+    EXPECT_TRUE(j.contains(key)) << key;
+}
+
+TEST(CaseSummary, FromJsonRejectsAResultWithoutItsParameters) {
+  nlohmann::json j = example().to_json();
+  j.erase("skalak_C");
+  EXPECT_THROW(CaseSummary::from_json(j), std::invalid_argument);
+  EXPECT_THROW(CaseSummary::from_json(nlohmann::json::array()), std::invalid_argument);
+}
+
+// Defect 7: every parameter is compared, skalak_C too (only for the Skalak law, as the case identity).
+TEST(CaseSummary, ParameterMismatchComparesEveryParameter) {
+  const CaseParameters p{0.3, 2.0, "skalak", 1.0, 2};
+  EXPECT_EQ(parameter_mismatch(p, p), "");
+  CaseParameters q = p;
+  q.skalak_C = 2.0;
+  EXPECT_EQ(parameter_mismatch(q, p), "skalak_C 2.0");
+  q = p;
+  q.capillary_number = 0.3 * (1 + 1e-12);  // decimal round trip noise
+  EXPECT_EQ(parameter_mismatch(q, p), "");
+  q.mesh_level = 3;
+  EXPECT_EQ(parameter_mismatch(q, p), "mesh_level 3");
+  CaseParameters nh{0.3, 2.0, "neo-hookean", 1.0, 2}, nh2 = nh;
+  nh2.skalak_C = 7.0;
+  EXPECT_EQ(parameter_mismatch(nh2, nh), "") << "skalak_C does not enter a neo-Hookean case";
+  nh2.law = "skalak";
+  EXPECT_NE(parameter_mismatch(nh2, nh), "");
+}
+
+// What run_case stores as case.h5's attributes is the summary (with the case file's own code_version).
+TEST(CaseSummary, CaseFileAttributesAreTheSummary) {
+  config::CaseConfig c;
+  c.level = 1;
+  c.t_end = 0.1;
+  const auto dir = std::filesystem::path(CAPSIM_TEST_TMP) / "driver" / "summary_attributes";
+  std::filesystem::remove_all(dir);
+  RunOptions o;
+  o.out_dir = dir;
+  const CaseResult r = run_case(c, o);
+  const CaseSummary s = CaseSummary::of(c, r);
+  const auto contents = io::read_case_file(r.case_file);
+  auto find = [&](const std::string& key) -> const io::Attribute* {
+    for (const auto& a : contents.attributes)
+      if (a.key == key) return &a;
+    return nullptr;
+  };
+  for (const auto& expected : summary_attributes(s)) {
+    const io::Attribute* a = find(expected.key);
+    ASSERT_NE(a, nullptr) << expected.key;
+    if (expected.key == "wall_s") continue;  // stored just before the file is closed
+    if (const double* v = std::get_if<double>(&expected.value); v && std::isnan(*v))
+      EXPECT_TRUE(std::isnan(std::get<double>(a->value))) << expected.key;
+    else
+      EXPECT_EQ(a->value, expected.value) << expected.key;
+  }
+  EXPECT_NE(find("code_version"), nullptr);
+  EXPECT_EQ(std::get<std::int64_t>(find("flow_evaluations")->value), r.flow_evaluations);
+}
+
+}  // namespace
+}  // namespace capsim::driver

@@ -4,7 +4,7 @@
 
 #include "campaign/store/store.h"
 #include "capsim/schema_sql.h"
-#include "test_util.h"
+#include "tests/campaign/test_util.h"
 
 namespace capsim::campaign::testing {
 namespace {

@@ -27,11 +27,8 @@ std::string format_with_error(double x, double error) {
     std::snprintf(buf, sizeof buf, "%.0f", std::round(x / q) * q);
   }
   std::string s = buf;
-  if (s == "-0" || s.rfind("-0.", 0) == 0) {
-    // -0.00 after rounding is 0.00: a sign the digits do not support.
-    bool zero = s.find_first_not_of("-0.") == std::string::npos;
-    if (zero) s.erase(0, 1);
-  }
+  // -0.00 after rounding is 0.00: a sign the digits do not support.
+  if (s[0] == '-' && s.find_first_not_of("-0.") == std::string::npos) s = s.substr(1);
   return s;
 }
 

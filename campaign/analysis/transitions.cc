@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <tuple>
+#include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "campaign/grid/decimal.h"
 
@@ -84,83 +85,69 @@ Transition analyse_group(Transition t, std::vector<Sample> samples, double thr) 
   return t;
 }
 
-namespace {
-double quantise(double x, double tolerance) {
-  // Round to a decimal quantum 10^-scale below tolerance/2, exactly (0.0275, not 0.027500000000000004).
-  const int scale = std::max(0, static_cast<int>(-std::floor(std::log10(tolerance / 2))));
-  return Decimal{static_cast<std::int64_t>(std::llround(x * std::pow(10.0, scale))), scale}.to_double();
+std::string group_key(const CaseParams& params) {
+  // The case identity hashes canonical() ("key=value" lines of the solver's resolved configuration, output keys
+  // left out); the group is that text without the Ca line, so two cases share a group exactly when their
+  // identities differ in Ca only. Values are JSON numbers/booleans where they parse as such, else strings.
+  nlohmann::json j = nlohmann::json::object();
+  std::istringstream lines(params.canonical());
+  std::string line;
+  while (std::getline(lines, line)) {
+    const auto eq = line.find('=');
+    if (eq == std::string::npos) continue;
+    const std::string k = line.substr(0, eq), v = line.substr(eq + 1);
+    if (k == "flow.capillary_number") continue;
+    auto parsed = nlohmann::json::parse(v, nullptr, false);
+    j[k] = (!parsed.is_discarded() && (parsed.is_number() || parsed.is_boolean() || parsed.is_string()))
+               ? parsed
+               : nlohmann::json(v);
+  }
+  return j.dump();
 }
-}  // namespace
 
-std::vector<double> propose_refinement(const Transition& t, std::vector<Sample> samples, double tol) {
-  std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.ca < b.ca; });
-  std::vector<double> out;
-  auto add = [&](double x) {
-    x = quantise(x, tol);
-    if (!(x > 0)) return;
-    for (const auto& s : samples)
-      if (std::fabs(s.ca - x) < 1e-12 * std::max(1.0, x)) return;
-    for (double y : out)
-      if (std::fabs(y - x) < 1e-12 * std::max(1.0, x)) return;
-    out.push_back(x);
-  };
-  // Ca* edges: bisect between the last sample above the threshold and the first below it (both sides).
-  if (t.ca_star_low && t.ca_star_below && *t.ca_star_low - *t.ca_star_below > tol)
-    add(0.5 * (*t.ca_star_low + *t.ca_star_below));
-  if (t.ca_star_high && t.ca_star_above && *t.ca_star_above - *t.ca_star_high > tol)
-    add(0.5 * (*t.ca_star_high + *t.ca_star_above));
-  // No sample below the threshold yet: bracket the minimum of min D12 more finely around the best sample.
-  if (!t.ca_star_low && t.ca_min_d12) {
-    auto it = std::find_if(samples.begin(), samples.end(), [&](const Sample& s) { return s.ca == *t.ca_min_d12; });
-    if (it != samples.end()) {
-      if (it != samples.begin() && it->ca - std::prev(it)->ca > tol) add(0.5 * (it->ca + std::prev(it)->ca));
-      if (std::next(it) != samples.end() && std::next(it)->ca - it->ca > tol) add(0.5 * (it->ca + std::next(it)->ca));
-    }
-  }
-  // CaH: false position clamped to the middle half of the bracket, so the bracket shrinks every round.
-  if (t.ca_h && t.ca_h_low && t.ca_h_high && *t.ca_h_high - *t.ca_h_low > tol) {
-    const double lo = *t.ca_h_low, hi = *t.ca_h_high, w = hi - lo;
-    add(std::clamp(*t.ca_h, lo + 0.25 * w, hi - 0.25 * w));
-  }
+std::string group_difference(const std::string& a, const std::string& b) {
+  const auto ja = nlohmann::json::parse(a, nullptr, false), jb = nlohmann::json::parse(b, nullptr, false);
+  if (!ja.is_object() || !jb.is_object()) return "";
+  std::string out;
+  auto text = [](const nlohmann::json& j, const std::string& k) { return j.contains(k) ? j[k].dump() : "unset"; };
+  std::map<std::string, bool> keys;
+  for (auto& [k, _] : ja.items()) keys[k] = true;
+  for (auto& [k, _] : jb.items()) keys[k] = true;
+  for (const auto& [k, _] : keys)
+    if (text(ja, k) != text(jb, k)) out += (out.empty() ? "" : ", ") + k + " (" + text(ja, k) + " vs " + text(jb, k) + ")";
   return out;
 }
 
-std::vector<SampleGroup> load_groups(Db& db, std::int64_t campaign_id) {
-  Stmt s(db,
-         "SELECT c.law, c.aspect_ratio, coalesce(c.skalak_C,-1), c.mesh_level, c.capillary_number, c.case_id, "
-         "r.min_D12, r.max_tau_min, c.status "
-         "FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id LEFT JOIN results r ON r.case_id=c.case_id "
-         "WHERE cc.campaign_id=? ORDER BY c.law, c.aspect_ratio, 3, c.mesh_level, c.capillary_number");
-  s.bind(1, campaign_id);
-  std::map<std::tuple<std::string, double, double, int>, SampleGroup> groups;
-  std::vector<std::tuple<std::string, double, double, int>> order;
-  while (s.step()) {
-    auto key = std::make_tuple(s.text(0), *s.real(1), *s.real(2), static_cast<int>(s.integer(3)));
-    auto [it, inserted] = groups.try_emplace(key);
-    if (inserted) {
-      order.push_back(key);
-      it->second.key.law = s.text(0);
-      it->second.key.aspect_ratio = *s.real(1);
-      it->second.key.skalak_C = *s.real(2);
-      it->second.key.mesh_level = static_cast<int>(s.integer(3));
-      it->second.some_case_id = s.text(5);
-    }
-    if (s.text(8) == "done") it->second.samples.push_back({*s.real(4), s.real(6), s.real(7), s.text(5)});
-  }
+std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases) {
+  std::map<std::string, std::size_t> index;
   std::vector<SampleGroup> out;
-  for (const auto& k : order) out.push_back(std::move(groups[k]));
+  for (const auto& c : cases) {
+    const std::string key = group_key(c.params);
+    auto [it, inserted] = index.try_emplace(key, out.size());
+    if (inserted) {
+      SampleGroup g;
+      g.key.group_key = key;
+      g.key.law = c.params.law();
+      g.key.aspect_ratio = c.params.aspect_ratio();
+      g.key.skalak_C = c.params.law() == "neo-hookean" ? -1.0 : c.params.skalak_C();
+      g.key.mesh_level = c.params.mesh_level();
+      g.base = c.params;
+      out.push_back(std::move(g));
+    }
+    SampleGroup& g = out[it->second];
+    g.case_ca.push_back(c.params.capillary_number());
+    if (c.status == "done") g.samples.push_back({c.params.capillary_number(), c.min_d12, c.max_tau_min, c.case_id});
+  }
   return out;
 }
 
-std::vector<Transition> analyse_campaign(Store& store, std::int64_t campaign_id, double thr,
-                                         const std::string& method) {
+std::vector<Transition> analyse_groups(const std::vector<SampleGroup>& groups, double thr, const std::string& method) {
   std::vector<Transition> rows;
-  for (auto& g : load_groups(store.db(), campaign_id)) {
+  for (const auto& g : groups) {
     Transition key = g.key;
     key.method = method;
     rows.push_back(analyse_group(key, g.samples, thr));
   }
-  store.save_transitions(campaign_id, rows);
   return rows;
 }
 

@@ -2,17 +2,40 @@
 /// @file
 /// @brief Critical capillary numbers from finished cases: the Ca* interval (sampled Ca with
 /// min D12 < threshold, the seed's Table 1 criterion) and CaH (zero of max tau_min, interpolated linearly
-/// between the bracketing samples), plus the refinement points of the adaptive mode.
+/// between the bracketing samples), computed per group of cases that agree in every identity key but Ca.
+/// Pure computation on values: the store reads the cases (CaseSample) and saves the rows (Transition); this
+/// folder never touches the database, so the store may use these types without a cycle (store -> analysis).
 
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "campaign/store/store.h"
+#include "campaign/grid/case_params.h"
 
 namespace capsim::campaign {
 
-/// @brief One finished case of a (law, a/b, C, level) group.
+/// @brief Critical capillary numbers of one group of cases (every identity key equal except Ca).
+struct Transition {
+  /// @brief Canonical JSON object of every identity key of the group except flow.capillary_number (the
+  /// solver's resolved values, as in the case identity): two groups differ exactly when this differs.
+  std::string group_key;
+  std::string law;                     ///< membrane law (also in group_key; a column for queries)
+  double aspect_ratio = 0;             ///< a/b
+  double skalak_C = -1;                ///< -1 for neo-hookean
+  int mesh_level = 0;                  ///< mesh level
+  double d12_threshold = 0.05;         ///< criterion used
+  int n_samples = 0;                   ///< finished samples used
+  std::optional<double> ca_star_low, ca_star_high;    ///< sampled Ca with min_D12 < threshold
+  std::optional<double> ca_star_below, ca_star_above; ///< nearest samples outside the interval
+  std::optional<double> ca_min_d12;    ///< sampled Ca of the smallest min_D12
+  std::optional<double> ca_h;          ///< interpolated zero of max_tau_min
+  std::optional<double> ca_h_low, ca_h_high;          ///< its bracket
+  std::string ca_h_low_case, ca_h_high_case;          ///< bracket case ids
+  std::string method = "grid";         ///< grid | adaptive
+  std::string note;                    ///< e.g. "CaH above sampled range"
+};
+
+/// @brief One finished case of a group.
 struct Sample {
   double ca = 0;                        ///< capillary number
   std::optional<double> min_d12;        ///< min D12 over the last period
@@ -20,26 +43,39 @@ struct Sample {
   std::string case_id;                  ///< identity
 };
 
+/// @brief One case of a campaign with its result, as the store reads it (the input of the grouping).
+struct CaseSample {
+  std::string case_id;                  ///< identity
+  CaseParams params;                    ///< all case keys
+  std::string status;                   ///< queued | running | done | unstable | failed
+  std::optional<double> min_d12;        ///< from its result (done/unstable), else nullopt
+  std::optional<double> max_tau_min;    ///< from its result, else nullopt
+};
+
+/// @brief The cases of one group.
+struct SampleGroup {
+  Transition key;                       ///< group_key, law, aspect_ratio, skalak_C (-1 neo-hookean), mesh_level
+  std::vector<Sample> samples;          ///< its done cases
+  std::vector<double> case_ca;          ///< Ca of every case of the group, any status (a case that exists)
+  CaseParams base;                      ///< one case of the group: the template of new cases
+};
+
+/// @brief The group key of a case: canonical JSON of its identity keys except Ca (see Transition::group_key).
+std::string group_key(const CaseParams& params);
+
+/// @brief The keys in which two group keys differ, as "key (a vs b), ..." (for messages); "" if equal or
+/// either is not a JSON object (a version-2 row).
+std::string group_difference(const std::string& group_key_a, const std::string& group_key_b);
+
+/// @brief Groups cases by group_key (groups in order of first appearance); a group with no done case is
+/// still listed (empty samples). @throws capsim::config::ConfigError for a case the solver rejects.
+std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases);
+
 /// @brief Computes the transition row of one group from its samples (any order; status done only).
 Transition analyse_group(Transition key, std::vector<Sample> samples, double d12_threshold);
 
-/// @brief Capillary numbers to add so the Ca* edges and the CaH bracket shrink below @p tolerance
-/// (adaptive mode); values are rounded to a decimal quantum below the tolerance and never repeat a sample.
-std::vector<double> propose_refinement(const Transition& t, std::vector<Sample> samples, double tolerance);
-
-/// @brief A group of samples with its key fields filled in a Transition.
-struct SampleGroup {
-  Transition key;               ///< law, aspect_ratio, skalak_C (-1 for neo-hookean), mesh_level
-  std::vector<Sample> samples;  ///< done cases of the group
-  std::string some_case_id;     ///< any case of the group (a template for new cases)
-};
-
-/// @brief Loads the done cases of a campaign grouped by (law, a/b, C, level); groups with no done case
-/// are still listed (empty samples) when the campaign has cases in them.
-std::vector<SampleGroup> load_groups(Db& db, std::int64_t campaign_id);
-
-/// @brief Recomputes and stores the transitions of a campaign; returns them.
-std::vector<Transition> analyse_campaign(Store& store, std::int64_t campaign_id, double d12_threshold,
-                                         const std::string& method);
+/// @brief analyse_group of every group, with @p method recorded.
+std::vector<Transition> analyse_groups(const std::vector<SampleGroup>& groups, double d12_threshold,
+                                       const std::string& method);
 
 }  // namespace capsim::campaign

@@ -4,12 +4,14 @@
 #include <cstdio>
 #include <exception>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "campaign/cli/commands.h"
 #include "campaign/common/bad_input.h"
 #include "campaign/grid/decimal.h"
+#include "campaign/query/precision.h"
 #include "campaign/query/table_output.h"
 #include "campaign/scheduler/campaign_runner.h"
 #include "campaign/slurm/slurm.h"
@@ -21,54 +23,51 @@ namespace {
 
 using campaign::BadInput;
 
+// The transitions as `status` prints them: sampled Ca as sampled, CaH to the leading digit of its bracket
+// width (its error bound), no digit more (`capsim query sql` gives the stored values in full).
+campaign::Table transitions_table(const std::vector<campaign::Transition>& rows) {
+  campaign::Table t;
+  t.columns = {"law", "aspect_ratio", "skalak_C", "mesh_level", "n_samples", "ca_star_low", "ca_star_high", "ca_h",
+               "ca_h_low", "ca_h_high", "method", "note"};
+  auto sampled = [](const std::optional<double>& x) {
+    return x ? campaign::SqlValue{campaign::format_sampled(*x)} : campaign::SqlValue{nullptr};
+  };
+  for (const auto& r : rows) {
+    campaign::SqlValue h = nullptr;
+    if (r.ca_h)
+      h = r.ca_h_low && r.ca_h_high ? campaign::format_with_error(*r.ca_h, *r.ca_h_high - *r.ca_h_low)
+                                    : campaign::format_significant(*r.ca_h, 3);
+    t.rows.push_back({r.law, campaign::format_sampled(r.aspect_ratio),
+                      r.skalak_C < 0 ? campaign::SqlValue{nullptr} : campaign::SqlValue{campaign::format_sampled(r.skalak_C)},
+                      std::int64_t{r.mesh_level}, std::int64_t{r.n_samples}, sampled(r.ca_star_low),
+                      sampled(r.ca_star_high), h, sampled(r.ca_h_low), sampled(r.ca_h_high), r.method, r.note});
+  }
+  return t;
+}
+
 int status(const std::string& db_path, const std::string& name) {
   auto store = campaign::Store::open_readonly(db_path);
-  auto& db = store->db();
-  campaign::Stmt camps(db, "SELECT campaign_id, name, updated_at FROM campaigns WHERE (?1 = '' OR name = ?1) "
-                           "ORDER BY campaign_id");
-  camps.bind(1, name);
-  int shown = 0;
-  while (camps.step()) {
-    ++shown;
-    const auto id = camps.integer(0);
-    std::printf("campaign '%s' (last run %s)\n", camps.text(1).c_str(), camps.text(2).c_str());
-    campaign::Stmt counts(db, "SELECT c.status, count(*), sum(cc.origin='adaptive') FROM cases c JOIN campaign_cases cc "
-                              "ON cc.case_id=c.case_id WHERE cc.campaign_id=? GROUP BY c.status");
-    counts.bind(1, id);
-    std::int64_t total = 0, adaptive = 0;
-    std::string line;
-    std::map<std::string, std::int64_t> by;
-    while (counts.step()) {
-      by[counts.text(0)] = counts.integer(1);
-      total += counts.integer(1);
-      adaptive += counts.integer(2);
-    }
+  const auto camps = store->campaigns(name);
+  for (const auto& c : camps) {
+    std::printf("campaign '%s' (last run %s)\n", c.name.c_str(), c.updated_at.c_str());
+    auto n = store->status_counts(c.campaign_id);
     std::printf("  %lld cases (%lld added by adaptive refinement): done %lld, unstable %lld, failed %lld, running %lld, "
                 "queued %lld\n",
-                (long long)total, (long long)adaptive, (long long)by["done"], (long long)by["unstable"],
-                (long long)by["failed"], (long long)by["running"], (long long)by["queued"]);
-    campaign::Stmt bad(db, "SELECT c.case_id, c.law, c.aspect_ratio, c.capillary_number, c.status, "
-                           "coalesce(c.error,'') FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id "
-                           "WHERE cc.campaign_id=? AND (c.status IN ('failed','unstable','running') OR "
-                           "(c.status='queued' AND c.attempts>0)) ORDER BY c.status, c.law, c.aspect_ratio, "
-                           "c.capillary_number LIMIT 50");
-    bad.bind(1, id);
-    while (bad.step()) {
-      std::string err = bad.text(5);
+                (long long)n.total, (long long)n.adaptive, (long long)n.by_status["done"],
+                (long long)n.by_status["unstable"], (long long)n.by_status["failed"], (long long)n.by_status["running"],
+                (long long)n.by_status["queued"]);
+    for (const auto& p : store->problem_cases(c.campaign_id, 50)) {
+      std::string err = p.error;
       if (err.size() > 160) err = err.substr(0, 157) + "...";
-      std::printf("  %-8s %s  %s a/b=%s Ca=%s  %s\n", bad.text(4).c_str(), bad.text(0).c_str(), bad.text(1).c_str(),
-                  campaign::canonical_double(*bad.real(2)).c_str(), campaign::canonical_double(*bad.real(3)).c_str(),
+      std::printf("  %-8s %s  %s a/b=%s Ca=%s  %s\n", p.status.c_str(), p.case_id.c_str(), p.law.c_str(),
+                  campaign::canonical_double(p.aspect_ratio).c_str(), campaign::canonical_double(p.capillary_number).c_str(),
                   err.c_str());
     }
-    campaign::Stmt tr(db, "SELECT law, aspect_ratio, CASE WHEN skalak_C < 0 THEN NULL ELSE skalak_C END AS skalak_C, "
-                          "mesh_level, n_samples, ca_star_low, ca_star_high, ca_h, ca_h_low, ca_h_high, method, note "
-                          "FROM transitions WHERE campaign_id=? ORDER BY law, aspect_ratio");
-    tr.bind(1, id);
-    auto t = campaign::query_table(db, tr);
-    if (!t.rows.empty()) std::printf("%s", campaign::render(t, campaign::Format::kMarkdown).c_str());
-    campaign::print_slurm_status(db, id);
+    if (auto tr = store->transitions(c.campaign_id); !tr.empty())
+      std::printf("%s", campaign::render(transitions_table(tr), campaign::Format::kMarkdown).c_str());
+    campaign::print_slurm_status(store->db(), c.campaign_id);
   }
-  if (shown == 0) {
+  if (camps.empty()) {
     if (!name.empty()) throw BadInput(db_path + ": no campaign named '" + name + "'");
     std::printf("no campaign in %s\n", db_path.c_str());
   }
@@ -134,7 +133,7 @@ int campaign_command(const std::vector<std::string>& args) {
       if (opt.jobs < 0 || opt.threads_per_job < 0 || (run->count("--jobs") && opt.jobs == 0) ||
           (run->count("--threads-per-job") && opt.threads_per_job == 0))
         throw BadInput("--jobs and --threads-per-job must be >= 1");
-      return campaign::run_campaign(opt);
+      return campaign::run_campaign(opt, campaign::check_no_live_slurm_tasks);
     }
     if (*submit) {
       if (submit->count("--array-limit") && sub.array_limit < 1) throw BadInput("--array-limit must be >= 1");

@@ -1,18 +1,18 @@
 // `capsim query table1|cases|sql`: read-only queries of a campaign database.
-#include <sqlite3.h>
-
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "campaign/cli/commands.h"
 #include "campaign/common/bad_input.h"
 #include "campaign/grid/decimal.h"
+#include "campaign/query/precision.h"
 #include "campaign/query/table_output.h"
 #include "campaign/store/store.h"
 
@@ -39,66 +39,50 @@ std::string law_label(const std::string& law, double C) {
   return law;
 }
 
-// A number of the table, or "–" for NULL.
-std::string format_value(const SqlValue& v, const char* format) {
-  if (auto* d = std::get_if<double>(&v)) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, format, *d);
-    return buf;
-  }
-  return "–";
-}
-
-// A sampled capillary number as it was sampled (0.175 stays 0.175, 0.2 prints as 0.2): "%.2f" would round
-// the adaptive refinements' edges onto the coarse grid.
-std::string sampled(const SqlValue& v) { return format_value(v, "%.6g"); }
-
-std::string fixed2(const SqlValue& v) { return format_value(v, "%.2f"); }
+SqlValue value_of(const std::optional<double>& x) { return x ? SqlValue{*x} : SqlValue{nullptr}; }
 
 int table1(campaign::Store& store, const std::string& name, campaign::Format fmt, int mesh_level, double skalak_C) {
   const std::string camp = resolve_campaign(store, name);
-  campaign::Stmt s(store.db(),
-                   "SELECT t.law, t.aspect_ratio, t.skalak_C, t.mesh_level, t.ca_star_low, t.ca_star_high, t.ca_h "
-                   "FROM transitions t JOIN campaigns c ON c.campaign_id=t.campaign_id WHERE c.name=? "
-                   "AND (?2 < 0 OR t.mesh_level = ?2) AND (?3 < -0.5 OR t.skalak_C = ?3 OR t.law='neo-hookean') "
-                   "ORDER BY t.law, t.aspect_ratio, t.mesh_level DESC");
-  s.bind(1, camp).bind(2, std::int64_t{mesh_level}).bind(3, skalak_C);
-  struct Row {
-    std::string law;
-    double ar, C;
-    std::int64_t level;
-    SqlValue lo, hi, h;
-  };
-  std::vector<Row> rows;
-  std::map<std::pair<std::string, double>, int> seen;
-  while (s.step()) {
-    Row r{s.text(0), *s.real(1), *s.real(2), s.integer(3), s.column(4), s.column(5), s.column(6)};
-    auto key = std::make_pair(r.law, r.ar);
-    if (seen.count(key)) {
-      const Row& first = rows[seen[key]];
-      if (first.level == r.level)
-        throw BadInput("campaign '" + camp + "' has several skalak_C values for " + r.law + " a/b=" +
-                       campaign::canonical_double(r.ar) + "; choose one with --skalak-C");
+  std::vector<campaign::Transition> rows;
+  // Per (law, a/b): the finest mesh level. Two groups there (two Skalak C, or a numerics axis) do not fit in
+  // one cell of the table: say which keys differ instead of picking one.
+  std::map<std::pair<std::string, double>, std::size_t> seen;
+  for (auto& r : store.transitions(*store.find_campaign(camp), mesh_level, skalak_C)) {
+    auto key = std::make_pair(r.law, r.aspect_ratio);
+    if (auto it = seen.find(key); it != seen.end()) {
+      const auto& first = rows[it->second];
+      if (first.mesh_level == r.mesh_level) {
+        if (first.skalak_C != r.skalak_C)
+          throw BadInput("campaign '" + camp + "' has several skalak_C values for " + r.law + " a/b=" +
+                         campaign::canonical_double(r.aspect_ratio) + "; choose one with --skalak-C");
+        throw BadInput("campaign '" + camp + "' has several transition groups for " + r.law + " a/b=" +
+                       campaign::canonical_double(r.aspect_ratio) + " at mesh level " + std::to_string(r.mesh_level) +
+                       ", they differ in " + campaign::group_difference(first.group_key, r.group_key) +
+                       "; see `capsim query sql \"SELECT group_key, ca_star_low, ca_star_high, ca_h FROM transitions\"`");
+      }
       continue;  // keep the finest mesh level
     }
-    seen[key] = static_cast<int>(rows.size());
-    rows.push_back(r);
+    seen[key] = rows.size();
+    rows.push_back(std::move(r));
   }
   if (rows.empty())
     throw BadInput("campaign '" + camp + "' has no transitions yet (run it first: capsim campaign run ...)");
   if (fmt != campaign::Format::kMarkdown) {
     campaign::Table t;
     t.columns = {"law", "aspect_ratio", "ca_star_low", "ca_star_high", "ca_h"};
-    for (const auto& r : rows) t.rows.push_back({r.law, r.ar, r.lo, r.hi, r.h});
+    for (const auto& r : rows)
+      t.rows.push_back({r.law, r.aspect_ratio, value_of(r.ca_star_low), value_of(r.ca_star_high), value_of(r.ca_h)});
     std::printf("%s", campaign::render(t, fmt).c_str());
     return 0;
   }
-  // Markdown laid out like the seed's Table 1: one column per a/b, a Ca* line and a CaH line per law.
+  // Markdown laid out like the seed's Table 1: one column per a/b, a Ca* line and a CaH line per law. The Ca*
+  // edges are sampled values (printed as sampled); CaH is interpolated in its bracket, whose width bounds its
+  // error: it is rounded to the leading digit of that width.
   std::vector<double> ars;
   std::vector<std::pair<std::string, double>> laws;
   for (const auto& r : rows) {
-    if (std::find(ars.begin(), ars.end(), r.ar) == ars.end()) ars.push_back(r.ar);
-    auto l = std::make_pair(r.law, r.C);
+    if (std::find(ars.begin(), ars.end(), r.aspect_ratio) == ars.end()) ars.push_back(r.aspect_ratio);
+    auto l = std::make_pair(r.law, r.skalak_C);
     if (std::find(laws.begin(), laws.end(), l) == laws.end()) laws.push_back(l);
   }
   std::sort(ars.begin(), ars.end());
@@ -110,17 +94,20 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
   for (const auto& [law, C] : laws) {
     std::string star = "| " + law_label(law, C) + " |", h = "| |";
     for (double a : ars) {
-      const Row* r = nullptr;
+      const campaign::Transition* r = nullptr;
       for (const auto& x : rows)
-        if (x.law == law && x.C == C && x.ar == a) r = &x;
+        if (x.law == law && x.skalak_C == C && x.aspect_ratio == a) r = &x;
       if (!r) {
         star += " |";
         h += " |";
         continue;
       }
-      star += std::holds_alternative<double>(r->lo) ? " Ca* ∈ [" + sampled(r->lo) + ", " + sampled(r->hi) + "] |"
-                                                    : " Ca* not found |";
-      h += std::holds_alternative<double>(r->h) ? " CaH = " + fixed2(r->h) + " |" : " CaH not bracketed |";
+      star += r->ca_star_low && r->ca_star_high ? " Ca* ∈ [" + campaign::format_sampled(*r->ca_star_low) + ", " +
+                                                      campaign::format_sampled(*r->ca_star_high) + "] |"
+                                                : " Ca* not found |";
+      h += r->ca_h && r->ca_h_low && r->ca_h_high
+               ? " CaH = " + campaign::format_with_error(*r->ca_h, *r->ca_h_high - *r->ca_h_low) + " |"
+               : " CaH not bracketed |";
     }
     out += star + "\n" + h + "\n";
   }
@@ -137,66 +124,20 @@ int cases(campaign::Store& store, const std::string& name, campaign::Format fmt,
     throw BadInput("--status: expected queued, running, done, unstable or failed, got '" + status + "'");
   if (!law.empty() && law != "neo-hookean" && law != "skalak")
     throw BadInput("--law: expected neo-hookean or skalak, got '" + law + "'");
-  campaign::Stmt s(store.db(),
-                   "SELECT c.case_id, c.law, c.aspect_ratio, c.skalak_C, c.mesh_level, c.capillary_number, c.status, "
-                   "c.attempts, r.min_D12, r.max_tau_min, r.mean_D12, r.period, r.regime, r.volume_drift, r.steps, "
-                   "r.dt, r.t_final, coalesce(r.wall_s, c.wall_s) AS wall_s, c.code_version, c.error, c.h5_path "
-                   "FROM cases c LEFT JOIN results r ON r.case_id=c.case_id "
-                   "WHERE (?1 = '' OR c.case_id IN (SELECT cc.case_id FROM campaign_cases cc JOIN campaigns k "
-                   "ON k.campaign_id=cc.campaign_id WHERE k.name=?1)) "
-                   "AND (?2 = '' OR c.law = ?2) AND (?3 <= 0 OR abs(c.aspect_ratio - ?3) < 1e-12) "
-                   "AND c.capillary_number >= ?4 AND c.capillary_number <= ?5 AND (?6 = '' OR c.status = ?6) "
-                   "ORDER BY c.law, c.aspect_ratio, c.skalak_C, c.mesh_level, c.capillary_number");
-  s.bind(1, camp).bind(2, law).bind(3, ar).bind(4, ca_min).bind(5, ca_max).bind(6, status);
-  auto t = campaign::query_table(store.db(), s);
+  campaign::CaseFilter f;
+  f.campaign = camp;
+  f.law = law;
+  f.aspect_ratio = ar;
+  f.ca_min = ca_min;
+  f.ca_max = ca_max;
+  f.status = status;
+  auto t = store.cases_table(f);
   std::printf("%s", campaign::render(t, fmt).c_str());
   return 0;
 }
 
 int sql(campaign::Store& store, const std::string& text, campaign::Format fmt) {
-  sqlite3* h = store.db().handle();
-  // Prepare every statement first: if any of them writes, nothing runs.
-  struct Finalize {
-    void operator()(sqlite3_stmt* s) const { sqlite3_finalize(s); }
-  };
-  std::vector<std::unique_ptr<sqlite3_stmt, Finalize>> stmts;
-  const char* p = text.c_str();
-  while (*p) {
-    sqlite3_stmt* raw = nullptr;
-    const char* tail = nullptr;
-    if (sqlite3_prepare_v2(h, p, -1, &raw, &tail) != SQLITE_OK) throw BadInput(std::string("sql: ") + sqlite3_errmsg(h));
-    p = tail;
-    if (!raw) continue;  // whitespace or comment
-    stmts.emplace_back(raw);
-    if (!sqlite3_stmt_readonly(raw))
-      throw BadInput(std::string("sql: refused, the database is opened read-only and this statement writes: ") +
-                     sqlite3_sql(raw));
-  }
-  if (stmts.empty()) throw BadInput("sql: empty statement");
-  for (auto& st : stmts) {
-    sqlite3_stmt* raw = st.get();
-    campaign::Table t;
-    const int n = sqlite3_column_count(raw);
-    for (int c = 0; c < n; ++c) t.columns.push_back(sqlite3_column_name(raw, c));
-    int rc;
-    while ((rc = sqlite3_step(raw)) == SQLITE_ROW) {
-      std::vector<SqlValue> row;
-      for (int c = 0; c < n; ++c) {
-        switch (sqlite3_column_type(raw, c)) {
-          case SQLITE_NULL: row.emplace_back(nullptr); break;
-          case SQLITE_INTEGER: row.emplace_back(static_cast<std::int64_t>(sqlite3_column_int64(raw, c))); break;
-          case SQLITE_FLOAT: row.emplace_back(sqlite3_column_double(raw, c)); break;
-          default: {
-            const unsigned char* x = sqlite3_column_text(raw, c);
-            row.emplace_back(std::string(x ? reinterpret_cast<const char*>(x) : ""));
-          }
-        }
-      }
-      t.rows.push_back(std::move(row));
-    }
-    if (rc != SQLITE_DONE) throw BadInput(std::string("sql: ") + sqlite3_errmsg(h));
-    if (n > 0) std::printf("%s", campaign::render(t, fmt).c_str());
-  }
+  for (const auto& t : campaign::run_readonly_sql(store.db(), text)) std::printf("%s", campaign::render(t, fmt).c_str());
   return 0;
 }
 

@@ -14,17 +14,6 @@ Format parse_format(const std::string& s) {
   throw BadInput("--format: expected md, csv or json, got '" + s + "'");
 }
 
-Table query_table(Db&, Stmt& stmt) {
-  Table t;
-  for (int c = 0; c < stmt.columns(); ++c) t.columns.push_back(stmt.column_name(c));
-  while (stmt.step()) {
-    std::vector<SqlValue> row;
-    for (int c = 0; c < stmt.columns(); ++c) row.push_back(stmt.column(c));
-    t.rows.push_back(std::move(row));
-  }
-  return t;
-}
-
 std::string cell_text(const SqlValue& v) {
   if (std::holds_alternative<std::nullptr_t>(v)) return "";
   if (auto* i = std::get_if<std::int64_t>(&v)) return std::to_string(*i);

@@ -18,13 +18,13 @@
 #include <set>
 #include <thread>
 
+#include "campaign/analysis/refinement.h"
 #include "campaign/analysis/transitions.h"
 #include "campaign/common/bad_input.h"
 #include "campaign/grid/campaign_spec.h"
 #include "campaign/grid/decimal.h"
 #include "campaign/scheduler/progress.h"
 #include "campaign/scheduler/worker_process.h"
-#include "campaign/slurm/slurm.h"
 #include "campaign/store/store.h"
 #include "solver/io/atomic_file.h"
 
@@ -251,35 +251,22 @@ void recover(Store& store, const std::string& runs_dir, const std::function<void
 
 }  // namespace
 
+std::vector<Transition> analyse_campaign(Store& store, std::int64_t campaign_id, double d12_threshold,
+                                         const std::string& method) {
+  auto rows = analyse_groups(group_cases(store.campaign_samples(campaign_id)), d12_threshold, method);
+  store.save_transitions(campaign_id, rows);
+  return rows;
+}
+
 int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir) {
-  int adaptive_so_far = static_cast<int>(std::get<std::int64_t>(
-      *store.db().scalar("SELECT count(*) FROM campaign_cases WHERE origin='adaptive' AND campaign_id=" +
-                         std::to_string(campaign_id))));
-  int budget = spec.analysis.max_cases - adaptive_so_far;
-  std::vector<CaseParams> add;
-  for (auto& g : load_groups(store.db(), campaign_id)) {
-    Transition key = g.key;
-    Transition t = analyse_group(key, g.samples, spec.analysis.d12_threshold);
-    auto cas = propose_refinement(t, g.samples, spec.analysis.ca_tolerance);
-    if (cas.empty()) continue;
-    Stmt s(store.db(), "SELECT params_json FROM cases WHERE case_id=?");
-    s.bind(1, g.some_case_id);
-    if (!s.step()) continue;
-    CaseParams base = CaseParams::from_json(s.text(0));
-    for (double ca : cas) {
-      if (budget <= 0) break;
-      CaseParams p = base;
-      p.set("flow.capillary_number", ca);
-      add.push_back(p);
-      --budget;
-    }
-  }
+  const int budget = spec.analysis.max_cases - store.count_campaign_cases(campaign_id, "adaptive");
+  const auto add = refinement_round(group_cases(store.campaign_samples(campaign_id)), spec.analysis.d12_threshold,
+                                    spec.analysis.ca_tolerance, budget);
   if (add.empty()) return 0;
   Transaction t(store.db());
-  int n = store.add_cases(campaign_id, add, "adaptive", runs_dir);
+  const int added = store.add_cases(campaign_id, add, "adaptive", runs_dir);
   t.commit();
-  (void)n;
-  return static_cast<int>(add.size());
+  return added;
 }
 
 namespace {
@@ -294,16 +281,13 @@ int dry_run(const RunOptions& opt, const CampaignSpec& spec, const std::vector<C
     const std::string id = p.identity(version);
     std::string action = "run: new";
     if (store) {
-      Stmt s(store->db(), "SELECT status, resumable, attempts, coalesce(error,'') FROM cases WHERE case_id=?");
-      s.bind(1, id);
-      if (s.step()) {
-        const std::string st = s.text(0);
-        if (st == "done" || st == "unstable") action = "skip: " + st;
-        else if (st == "failed") action = opt.retry_failed ? "run: retry failed (" + s.text(3).substr(0, 60) + ")"
-                                                           : "skip: failed (use --retry-failed)";
-        else if (st == "running") action = "run: orphaned by a stopped manager (recovered first)";
-        else if (s.integer(1)) action = "run: interrupted, resume from checkpoint";
-        else if (s.integer(2) > 0) action = "run: interrupted, restart";
+      if (auto st = store->case_state(id)) {
+        if (st->status == "done" || st->status == "unstable") action = "skip: " + st->status;
+        else if (st->status == "failed") action = opt.retry_failed ? "run: retry failed (" + st->error.substr(0, 60) + ")"
+                                                                   : "skip: failed (use --retry-failed)";
+        else if (st->status == "running") action = "run: orphaned by a stopped manager (recovered first)";
+        else if (st->resumable) action = "run: interrupted, resume from checkpoint";
+        else if (st->attempts > 0) action = "run: interrupted, restart";
         else action = "run: queued";
       }
     }
@@ -372,7 +356,7 @@ PreparedCampaign prepare_campaign(const RunOptions& opt, const std::function<voi
   return pc;
 }
 
-int run_campaign(const RunOptions& opt) {
+int run_campaign(const RunOptions& opt, const BeforeRun& before_run) {
   const CampaignSpec spec = load_campaign_file(opt.campaign_file);
   const std::vector<CaseParams> cases = expand_grid(spec);
   if (opt.order != "longest" && opt.order != "grid")
@@ -392,7 +376,7 @@ int run_campaign(const RunOptions& opt) {
     if (runner_ptr) runner_ptr->message(m);
     else early.push_back(m);
   });
-  check_no_live_slurm_tasks(*pc.store, pc.campaign_id);
+  if (before_run) before_run(*pc.store, pc.campaign_id);
   SignalGuard signals;
   auto& store = pc.store;
   const std::int64_t campaign_id = pc.campaign_id;

@@ -36,8 +36,12 @@ enum RunExit {
   kRunInterrupted = 3,  ///< stopped by SIGINT/SIGTERM; rerun the same command to resume
 };
 
+/// @brief A check run after the campaign is prepared and before any local worker starts (the command line
+/// passes the Slurm layer's check_no_live_slurm_tasks: the scheduler does not know Slurm, slurm/ uses it).
+using BeforeRun = std::function<void(Store& store, std::int64_t campaign_id)>;
+
 /// @brief Runs a campaign; returns a RunExit code. @throws BadInput (caller prints it, exits 2).
-int run_campaign(const RunOptions& opt);
+int run_campaign(const RunOptions& opt, const BeforeRun& before_run = {});
 
 /// @brief The default runs folder of a database: DB + ".runs".
 std::string default_runs_dir(const std::string& db_path);
@@ -78,8 +82,12 @@ PreparedCampaign prepare_campaign(const RunOptions& opt, const std::function<voi
 /// atomically; returns the folder.
 std::string prepare_case_folder(const CaseRow& row, const std::string& runs_dir);
 
-/// @brief Adds adaptive cases to bracket the transitions of a campaign (adaptive mode, one round);
-/// returns how many were added.
+/// @brief Recomputes the transitions of a campaign (analysis/ per group) and stores them; returns them.
+std::vector<Transition> analyse_campaign(Store& store, std::int64_t campaign_id, double d12_threshold,
+                                         const std::string& method);
+
+/// @brief One adaptive round (analysis/refinement.h) within the campaign's max_cases budget; returns how many
+/// cases it added to the campaign (0: nothing left to refine).
 int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir);
 
 /// @brief Writes @p text to @p path via a temporary file in the same folder and rename (atomic).

@@ -18,6 +18,8 @@
 #include "campaign/scheduler/worker_process.h"
 #include "campaign/slurm/slurm.h"
 #include "campaign/slurm/slurm_internal.h"
+#include "campaign/scheduler/campaign_runner.h"
+#include "campaign/store/slurm_store.h"
 #include "campaign/store/store.h"
 
 namespace capsim::campaign {
@@ -25,8 +27,6 @@ namespace capsim::campaign {
 namespace fs = std::filesystem;
 
 namespace {
-
-const char* kNow = "strftime('%Y-%m-%dT%H:%M:%fZ','now')";
 
 std::string read_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -53,12 +53,12 @@ std::optional<nlohmann::json> exit_record(const std::string& dir, const std::str
   }
 }
 
-SqlValue opt_num(const std::optional<nlohmann::json>& j, const char* k) {
-  if (!j || !j->contains(k) || !(*j)[k].is_number()) return nullptr;
+std::optional<double> opt_num(const std::optional<nlohmann::json>& j, const char* k) {
+  if (!j || !j->contains(k) || !(*j)[k].is_number()) return std::nullopt;
   return (*j)[k].get<double>();
 }
-SqlValue opt_str(const std::optional<nlohmann::json>& j, const char* k) {
-  if (!j || !j->contains(k) || !(*j)[k].is_string()) return nullptr;
+std::optional<std::string> opt_str(const std::optional<nlohmann::json>& j, const char* k) {
+  if (!j || !j->contains(k) || !(*j)[k].is_string()) return std::nullopt;
   return (*j)[k].get<std::string>();
 }
 
@@ -70,31 +70,10 @@ struct CollectCounts {
   int changes() const { return ingested_done + ingested_unstable + failed + interrupted + lost; }
 };
 
-std::vector<std::string> open_job_ids(Db& db) {
-  std::vector<std::string> ids;
-  if (!has_table(db, "slurm_jobs")) return ids;
-  Stmt s(db, "SELECT DISTINCT job_id FROM slurm_tasks WHERE state='submitted'");
-  while (s.step()) ids.push_back(s.text(0));
-  return ids;
-}
-
-std::set<std::int64_t> campaigns_of(Db& db, const std::string& case_id) {
-  std::set<std::int64_t> out;
-  Stmt s(db, "SELECT campaign_id FROM campaign_cases WHERE case_id=?");
-  s.bind(1, case_id);
-  while (s.step()) out.insert(s.integer(0));
-  return out;
-}
-
 void add_attempt(Db& db, const std::string& case_id, const std::optional<nlohmann::json>& ex, const std::string& outcome,
                  std::optional<int> exit_code, const std::string& error) {
-  Stmt a(db, std::string("INSERT INTO attempts(case_id,started_at,finished_at,host,worker_pid,resumed,outcome,exit_code,"
-                         "error) VALUES(?,") + kNow + "," + kNow + ",?,NULL,?,?,?,?)");
-  a.bind(1, case_id).bind(2, opt_str(ex, "host"));
-  a.bind(3, std::int64_t{ex && ex->contains("resumed") && (*ex)["resumed"].is_boolean() && (*ex)["resumed"].get<bool>()});
-  a.bind(4, outcome).bind(5, exit_code ? SqlValue{std::int64_t{*exit_code}} : SqlValue{nullptr});
-  a.bind(6, error.empty() ? SqlValue{nullptr} : SqlValue{error});
-  a.step();
+  const bool resumed = ex && ex->contains("resumed") && (*ex)["resumed"].is_boolean() && (*ex)["resumed"].get<bool>();
+  add_collected_attempt(db, case_id, opt_str(ex, "host"), resumed, outcome, exit_code, error);
 }
 
 /// The core of collect (also the first step of submit). The caller holds the database lock; one
@@ -102,23 +81,17 @@ void add_attempt(Db& db, const std::string& case_id, const std::optional<nlohman
 CollectCounts collect_pass(Store& store, std::optional<std::int64_t> campaign_id, const QueueState& queue) {
   Db& db = store.db();
   CollectCounts n;
-  const bool slurm_tables = has_table(db, "slurm_tasks");
   Transaction t(db);
   // 1. Valid result files in the folders of unfinished cases (whoever wrote them: an array task, a hand run).
   {
-    std::string q = "SELECT c.case_id, c.params_json, c.out_dir FROM cases c WHERE c.status IN ('queued','failed')";
-    if (campaign_id) q += " AND c.case_id IN (SELECT case_id FROM campaign_cases WHERE campaign_id=?1)";
-    Stmt s(db, q);
-    if (campaign_id) s.bind(1, *campaign_id);
     struct Found {
       std::string id, line, dir;
       CaseParams params;
     };
     std::vector<Found> found;
-    while (s.step()) {
-      const std::string dir = s.text(2);
-      if (dir.empty() || !fs::exists(dir + "/" + kResultFile)) continue;
-      found.push_back({s.text(0), result_line_of(dir), dir, CaseParams::from_json(s.text(1))});
+    for (auto& c : unfinished_cases(db, campaign_id)) {
+      if (c.out_dir.empty() || !fs::exists(c.out_dir + "/" + kResultFile)) continue;
+      found.push_back({c.case_id, result_line_of(c.out_dir), c.out_dir, std::move(c.params)});
     }
     for (auto& f : found) {
       auto j = parse_result_line(f.line);
@@ -133,61 +106,38 @@ CollectCounts collect_pass(Store& store, std::optional<std::int64_t> campaign_id
       const auto ex = exit_record(f.dir, "");
       insert_result(db, f.id, *j, f.line);
       const std::string h5 = fs::exists(f.dir + "/case.h5") ? f.dir + "/case.h5" : "";
-      Stmt u(db, std::string("UPDATE cases SET status=?, resumable=0, finished_at=") + kNow +
-                     ", wall_s=coalesce(?,?), exit_code=0, host=coalesce(?,host), code_version=coalesce(?,code_version), "
-                     "error=?, h5_path=?, attempts=attempts+1 WHERE case_id=?");
-      u.bind(1, status).bind(2, opt_num(ex, "wall_s")).bind(3, opt_num(j, "wall_s")).bind(4, opt_str(ex, "host"));
-      u.bind(5, opt_str(j, "code_version"));
-      u.bind(6, status == "unstable" ? SqlValue{result_reason(*j)} : SqlValue{nullptr});
-      u.bind(7, h5.empty() ? SqlValue{nullptr} : SqlValue{h5}).bind(8, f.id);
-      u.step();
-      add_attempt(db, f.id, ex, status, 0, status == "unstable" ? result_reason(*j) : "");
-      if (slurm_tables) {
-        Stmt st(db, std::string("UPDATE slurm_tasks SET state='ingested', exit_code=0, host=?, wall_s=?, resolved_at=") +
-                        kNow + " WHERE case_id=? AND state='submitted'");
-        st.bind(1, opt_str(ex, "host")).bind(2, opt_num(ex, "wall_s")).bind(3, f.id);
-        st.step();
-      }
+      const std::string reason = status == "unstable" ? result_reason(*j) : "";
+      mark_collected_result(db, f.id, status, opt_num(ex, "wall_s"), opt_num(j, "wall_s"), opt_str(ex, "host"),
+                            opt_str(j, "code_version"), reason, h5);
+      add_attempt(db, f.id, ex, status, 0, reason);
+      if (has_table(db, "slurm_tasks")) resolve_task(db, "", f.id, "ingested", 0, opt_str(ex, "host"), opt_num(ex, "wall_s"));
       (status == "done" ? n.ingested_done : n.ingested_unstable)++;
-      for (auto c : campaigns_of(db, f.id)) n.changed_campaigns.insert(c);
+      for (auto c : campaigns_of_case(db, f.id)) n.changed_campaigns.insert(c);
     }
   }
   // 2. Cases of array tasks that ended without a valid result: failed, interrupted (resumable) or lost.
-  if (slurm_tables) {
-    std::string q = "SELECT st.job_id, st.task_index, st.case_id, c.status, c.out_dir FROM slurm_tasks st "
-                    "JOIN cases c ON c.case_id=st.case_id JOIN slurm_jobs j ON j.job_id=st.job_id "
-                    "WHERE st.state='submitted'";
-    if (campaign_id) q += " AND j.campaign_id=?1";
-    q += " ORDER BY st.job_id, st.position";
-    Stmt s(db, q);
-    if (campaign_id) s.bind(1, *campaign_id);
-    struct Open {
-      std::string job, id, status, dir;
-      int task;
-    };
-    std::vector<Open> open;
-    while (s.step()) open.push_back({s.text(0), s.text(2), s.text(3), s.text(4), static_cast<int>(s.integer(1))});
-    for (const auto& o : open) {
+  if (has_table(db, "slurm_tasks")) {
+    for (const auto& task : submitted_tasks(db, campaign_id)) {
       if (!queue.available) {
         ++n.unknown;
         continue;
       }
-      if (queue.live(o.job, o.task)) {
+      if (queue.live(task.job_id, task.task_index)) {
         ++n.live;
         continue;
       }
-      const std::string job_task = o.job + "_" + std::to_string(o.task);
-      const auto ex = exit_record(o.dir, job_task);
-      const bool checkpoint = has_checkpoint(o.dir);
+      const std::string job_task = task.job_id + "_" + std::to_string(task.task_index);
+      const auto ex = exit_record(task.out_dir, job_task);
+      const bool checkpoint = has_checkpoint(task.out_dir);
       std::string state, status, error;
       std::optional<int> code;
       if (ex) code = (*ex)["exit_code"].get<int>();
-      if (o.status != "queued" && o.status != "failed") {
+      if (task.status != "queued" && task.status != "failed") {
         state = "ingested";  // finished by other means (e.g. a local `campaign run`)
       } else if (code && *code == 0) {
         state = status = "failed";
         error = "Slurm array task " + job_task + ": worker exited 0 but " + kResultFile +
-                " is missing or not a valid result; stdout ends: " + tail_of(o.dir + "/stdout.log", 300);
+                " is missing or not a valid result; stdout ends: " + tail_of(task.out_dir + "/stdout.log", 300);
       } else if (code && *code == kExitInterrupted) {
         state = "interrupted";
         status = "queued";
@@ -197,7 +147,7 @@ CollectCounts collect_pass(Store& store, std::optional<std::int64_t> campaign_id
         state = status = "failed";
         error = "worker exited with code " + std::to_string(*code) + describe_exit_code(*code) +
                 (*code > 128 ? " (signal " + std::to_string(*code - 128) + ")" : "") + " in Slurm array task " +
-                job_task + "; stderr: " + tail_of(o.dir + "/stderr.log", 600);
+                job_task + "; stderr: " + tail_of(task.out_dir + "/stderr.log", 600);
       } else {
         state = "lost";
         status = "queued";
@@ -205,27 +155,17 @@ CollectCounts collect_pass(Store& store, std::optional<std::int64_t> campaign_id
                 "failure)" + std::string(checkpoint ? "; resumes from its checkpoint" : "");
       }
       if (!status.empty()) {
-        Stmt u(db, std::string("UPDATE cases SET status=?, resumable=?, error=?, exit_code=?, host=coalesce(?,host), "
-                               "finished_at=") + kNow + ", attempts=attempts+? WHERE case_id=?");
-        u.bind(1, status).bind(2, std::int64_t{status == "queued" && checkpoint}).bind(3, error);
-        u.bind(4, code ? SqlValue{std::int64_t{*code}} : SqlValue{nullptr}).bind(5, opt_str(ex, "host"));
-        u.bind(6, std::int64_t{ex ? 1 : 0}).bind(7, o.id);
-        u.step();
-        if (ex) add_attempt(db, o.id, ex, state == "failed" ? "failed" : "interrupted", code, error);
-        for (auto c : campaigns_of(db, o.id)) n.changed_campaigns.insert(c);
+        mark_collected_failure(db, task.case_id, status, status == "queued" && checkpoint, error, code, opt_str(ex, "host"),
+                               ex.has_value());
+        if (ex) add_attempt(db, task.case_id, ex, state == "failed" ? "failed" : "interrupted", code, error);
+        for (auto c : campaigns_of_case(db, task.case_id)) n.changed_campaigns.insert(c);
       }
-      Stmt st(db, std::string("UPDATE slurm_tasks SET state=?, exit_code=?, host=?, wall_s=?, resolved_at=") + kNow +
-                      " WHERE job_id=? AND case_id=?");
-      st.bind(1, state).bind(2, code ? SqlValue{std::int64_t{*code}} : SqlValue{nullptr});
-      st.bind(3, opt_str(ex, "host")).bind(4, opt_num(ex, "wall_s")).bind(5, o.job).bind(6, o.id);
-      st.step();
+      resolve_task(db, task.job_id, task.case_id, state, code, opt_str(ex, "host"), opt_num(ex, "wall_s"));
       if (state == "failed") ++n.failed;
       else if (state == "interrupted") ++n.interrupted;
       else if (state == "lost") ++n.lost;
     }
-    db.exec(std::string("UPDATE slurm_jobs SET state='collected', collected_at=") + kNow +
-            " WHERE state='submitted' AND NOT EXISTS (SELECT 1 FROM slurm_tasks t WHERE t.job_id=slurm_jobs.job_id "
-            "AND t.state='submitted')");
+    close_collected_jobs(db);
   }
   t.commit();
   return n;
@@ -234,13 +174,12 @@ CollectCounts collect_pass(Store& store, std::optional<std::int64_t> campaign_id
 /// Recomputes the transitions of the campaigns whose results changed (as `campaign run` does at its end).
 void reanalyse(Store& store, const std::set<std::int64_t>& campaigns) {
   for (auto id : campaigns) {
-    Stmt s(store.db(), "SELECT spec_json FROM campaigns WHERE campaign_id=?");
-    s.bind(1, id);
-    if (!s.step()) continue;
+    const auto spec_json = store.campaign_spec_json(id);
+    if (!spec_json) continue;
     double threshold = 0.05;
     std::string method = "grid";
     try {
-      auto j = nlohmann::json::parse(s.text(0));
+      auto j = nlohmann::json::parse(*spec_json);
       threshold = j.at("analysis").at("D12_threshold").get<double>();
       if (j.at("analysis").value("adaptive", false)) method = "adaptive";
     } catch (...) {
@@ -295,11 +234,9 @@ void check_no_live_slurm_tasks(Store& store, std::int64_t campaign_id) {
   const QueueState queue = query_queue(ids);
   CollectCounts n = collect_pass(store, std::nullopt, queue);
   reanalyse(store, n.changed_campaigns);
-  Stmt s(store.db(), "SELECT count(*), group_concat(DISTINCT t.job_id) FROM slurm_tasks t JOIN campaign_cases cc ON "
-                     "cc.case_id=t.case_id WHERE t.state='submitted' AND cc.campaign_id=?");
-  s.bind(1, campaign_id);
-  if (s.step() && s.integer(0) > 0)
-    throw BadInput(std::to_string(s.integer(0)) + " case(s) of this campaign are in Slurm job(s) " + s.text(1) +
+  const auto [open, jobs] = open_tasks_of_campaign(store.db(), campaign_id);
+  if (open > 0)
+    throw BadInput(std::to_string(open) + " case(s) of this campaign are in Slurm job(s) " + jobs +
                    (queue.available ? " still queued or running" : " whose state is unknown (" + queue.error + ")") +
                    "; wait for them (or scancel) and run `capsim campaign collect` before `campaign run`");
 }
@@ -342,21 +279,15 @@ int submit_campaign(const SubmitOptions& opt) {
     std::set<std::string> busy;
     if (store) {
       const QueueState q = query_queue(open_job_ids(store->db()));
-      if (has_table(store->db(), "slurm_tasks")) {
-        Stmt st(store->db(), "SELECT job_id, task_index, case_id FROM slurm_tasks WHERE state='submitted'");
-        while (st.step())
-          if (!q.available || q.live(st.text(0), static_cast<int>(st.integer(1)))) busy.insert(st.text(2));
-      }
+      for (const auto& task : submitted_tasks(store->db()))
+        if (!q.available || q.live(task.job_id, task.task_index)) busy.insert(task.case_id);
     }
     std::vector<std::pair<double, std::string>> pending;
     for (const auto& p : expand_grid(spec)) {
       const std::string id = p.identity(solver_version());
       std::string status = "queued";
-      if (store) {
-        Stmt c(store->db(), "SELECT status FROM cases WHERE case_id=?");
-        c.bind(1, id);
-        if (c.step()) status = c.text(0);
-      }
+      if (store)
+        if (auto st = store->case_state(id)) status = st->status;
       if (status == "failed" && opt.run.retry_failed) status = "queued";
       if (status != "queued" || busy.count(id) || parse_result_line(result_line_of(runs + "/" + id))) continue;
       pending.emplace_back(p.estimated_cost(), id);
@@ -395,11 +326,8 @@ int submit_campaign(const SubmitOptions& opt) {
     }
   }
   std::set<std::string> busy;
-  {
-    Stmt st(db, "SELECT job_id, task_index, case_id FROM slurm_tasks WHERE state='submitted'");
-    while (st.step())
-      if (!queue.available || queue.live(st.text(0), static_cast<int>(st.integer(1)))) busy.insert(st.text(2));
-  }
+  for (const auto& task : submitted_tasks(db))
+    if (!queue.available || queue.live(task.job_id, task.task_index)) busy.insert(task.case_id);
   if (!busy.empty() && !queue.available)
     log("capsim campaign submit: " + std::to_string(busy.size()) + " case(s) of earlier jobs are left alone (" +
         queue.error + ")");
@@ -436,24 +364,21 @@ int submit_campaign(const SubmitOptions& opt) {
                    "; script " + script_path + "; no job recorded");
   const int tasks = array_size(static_cast<int>(s.case_ids.size()), s.cases_per_task);
   {
-    Transaction t(db);
-    Stmt j(db, std::string("INSERT INTO slurm_jobs(job_id,campaign_id,submitted_at,script_path,n_tasks,n_cases,"
-                           "cases_per_task,array_limit,partition,time_limit,threads) VALUES(?,?,") + kNow +
-                   ",?,?,?,?,?,?,?,?)");
-    j.bind(1, job).bind(2, pc.campaign_id).bind(3, script_path).bind(4, std::int64_t{tasks});
-    j.bind(5, std::int64_t(s.case_ids.size())).bind(6, std::int64_t{s.cases_per_task});
-    j.bind(7, s.array_limit > 0 ? SqlValue{std::int64_t{s.array_limit}} : SqlValue{nullptr});
-    j.bind(8, s.partition.empty() ? SqlValue{nullptr} : SqlValue{s.partition});
-    j.bind(9, s.time_limit.empty() ? SqlValue{nullptr} : SqlValue{s.time_limit}).bind(10, std::int64_t{threads});
-    j.step();
-    Stmt c(db, "INSERT INTO slurm_tasks(job_id,task_index,position,case_id,resumed) VALUES(?,?,?,?,?)");
-    for (std::size_t i = 0; i < pending.size(); ++i) {
-      c.reset();
-      c.bind(1, job).bind(2, std::int64_t(i / s.cases_per_task)).bind(3, std::int64_t(i)).bind(4, pending[i].case_id);
-      c.bind(5, std::int64_t{has_checkpoint(pending[i].out_dir)});
-      c.step();
+    SlurmJobRecord rec;
+    rec.job_id = job;
+    rec.campaign_id = pc.campaign_id;
+    rec.script_path = script_path;
+    rec.n_tasks = tasks;
+    rec.cases_per_task = s.cases_per_task;
+    rec.array_limit = s.array_limit;
+    rec.partition = s.partition;
+    rec.time_limit = s.time_limit;
+    rec.threads = threads;
+    for (const auto& p : pending) {
+      rec.case_ids.push_back(p.case_id);
+      rec.resumed.push_back(has_checkpoint(p.out_dir));
     }
-    t.commit();
+    record_slurm_job(db, rec);
   }
   std::printf("submitted job %s: %zu case(s) of '%s' in %d array task(s), %d per task%s%s%s, %d thread(s) each\n",
               job.c_str(), s.case_ids.size(), spec.name.c_str(), tasks, s.cases_per_task,
@@ -465,18 +390,14 @@ int submit_campaign(const SubmitOptions& opt) {
 }
 
 void print_slurm_status(Db& db, std::int64_t campaign_id) {
-  if (!has_table(db, "slurm_jobs")) return;
-  Stmt s(db, "SELECT j.job_id, j.n_tasks, j.n_cases, j.submitted_at, "
-             "(SELECT count(*) FROM slurm_tasks t WHERE t.job_id=j.job_id AND t.state='submitted') "
-             "FROM slurm_jobs j WHERE j.campaign_id=? AND j.state='submitted' ORDER BY j.submitted_at");
-  s.bind(1, campaign_id);
+  const auto open = open_slurm_jobs(db, campaign_id);
+  if (open.empty()) return;
   struct Job {
     std::string id, submitted;
     std::int64_t tasks, cases, open;
   };
   std::vector<Job> jobs;
-  while (s.step()) jobs.push_back({s.text(0), s.text(3), s.integer(1), s.integer(2), s.integer(4)});
-  if (jobs.empty()) return;
+  for (const auto& j : open) jobs.push_back({j.job_id, j.submitted_at, j.n_tasks, j.n_cases, j.open_cases});
   std::vector<std::string> ids;
   for (auto& j : jobs) ids.push_back(j.id);
   const QueueState q = query_queue(ids);

@@ -30,6 +30,12 @@ using SqlValue = std::variant<std::nullptr_t, std::int64_t, double, std::string>
 
 class Db;
 
+/// @brief Rows of a query with named columns (what `capsim query` renders).
+struct Table {
+  std::vector<std::string> columns;             ///< column names (JSON keys)
+  std::vector<std::vector<SqlValue>> rows;      ///< one vector per row, same length as columns
+};
+
 /// @brief A prepared statement; bind with bind(i, v) (1-based), step() until it returns false.
 class Stmt {
  public:

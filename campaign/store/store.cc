@@ -118,6 +118,73 @@ bool has_table(Db& db, const std::string& name) {
   return s.step();
 }
 
+bool has_column(Db& db, const std::string& table, const std::string& column) {
+  Stmt s(db, "SELECT 1 FROM pragma_table_info(?) WHERE name=?");
+  s.bind(1, table).bind(2, column);
+  return s.step();
+}
+
+std::vector<Table> run_readonly_sql(Db& db, const std::string& text) {
+  sqlite3* h = db.handle();
+  struct Finalize {
+    void operator()(sqlite3_stmt* s) const { sqlite3_finalize(s); }
+  };
+  std::vector<std::unique_ptr<sqlite3_stmt, Finalize>> stmts;
+  const char* p = text.c_str();
+  while (*p) {
+    sqlite3_stmt* raw = nullptr;
+    const char* tail = nullptr;
+    if (sqlite3_prepare_v2(h, p, -1, &raw, &tail) != SQLITE_OK) throw BadInput(std::string("sql: ") + sqlite3_errmsg(h));
+    p = tail;
+    if (!raw) continue;  // whitespace or comment
+    stmts.emplace_back(raw);
+    if (!sqlite3_stmt_readonly(raw))
+      throw BadInput(std::string("sql: refused, the database is opened read-only and this statement writes: ") +
+                     sqlite3_sql(raw));
+  }
+  if (stmts.empty()) throw BadInput("sql: empty statement");
+  std::vector<Table> out;
+  for (auto& st : stmts) {
+    sqlite3_stmt* raw = st.get();
+    Table t;
+    const int n = sqlite3_column_count(raw);
+    for (int c = 0; c < n; ++c) t.columns.push_back(sqlite3_column_name(raw, c));
+    int rc;
+    while ((rc = sqlite3_step(raw)) == SQLITE_ROW) {
+      std::vector<SqlValue> row;
+      for (int c = 0; c < n; ++c) {
+        switch (sqlite3_column_type(raw, c)) {
+          case SQLITE_NULL: row.emplace_back(nullptr); break;
+          case SQLITE_INTEGER: row.emplace_back(static_cast<std::int64_t>(sqlite3_column_int64(raw, c))); break;
+          case SQLITE_FLOAT: row.emplace_back(sqlite3_column_double(raw, c)); break;
+          default: {
+            const unsigned char* x = sqlite3_column_text(raw, c);
+            row.emplace_back(std::string(x ? reinterpret_cast<const char*>(x) : ""));
+          }
+        }
+      }
+      t.rows.push_back(std::move(row));
+    }
+    if (rc != SQLITE_DONE) throw BadInput(std::string("sql: ") + sqlite3_errmsg(h));
+    if (n > 0) out.push_back(std::move(t));
+  }
+  return out;
+}
+
+namespace {
+/// Collects the rows of a read-only statement.
+Table read_table(Stmt& stmt) {
+  Table t;
+  for (int c = 0; c < stmt.columns(); ++c) t.columns.push_back(stmt.column_name(c));
+  while (stmt.step()) {
+    std::vector<SqlValue> row;
+    for (int c = 0; c < stmt.columns(); ++c) row.push_back(stmt.column(c));
+    t.rows.push_back(std::move(row));
+  }
+  return t;
+}
+}  // namespace
+
 std::string host_name() {
   char buf[256] = {0};
   if (gethostname(buf, sizeof buf - 1) != 0) return "unknown";
@@ -161,10 +228,11 @@ std::unique_ptr<Store> Store::open_for_write(const std::string& path) {
       s.step();
       t.commit();
     } else if (version < expected_schema_version()) {
-      // Migration: the embedded DDL is additive and idempotent (CREATE ... IF NOT EXISTS) from version
-      // kOldestMigratableVersion on, so applying all of it adds what is missing and raises user_version.
+      // Migration: each schemas/NNN_*.sql above the file's version, in order, once (002 only adds tables;
+      // 003 rebuilds `transitions` with its group key), all in one transaction.
       Transaction t(*db);
-      db->exec(kSchemaSql);
+      for (const auto& part : kSchemaParts)
+        if (part.version > version) db->exec(part.sql);
       Stmt s(*db, std::string("INSERT OR REPLACE INTO meta(key,value) VALUES('migrated_at',") + kNow +
                       "),('migrated_from',?),('migrated_by',?),('schema_version',?)");
       s.bind(1, std::to_string(version)).bind(2, std::string(kGitCommit));
@@ -226,7 +294,7 @@ int Store::add_cases(std::int64_t campaign_id, const std::vector<CaseParams>& ca
                              "skalak_C,mesh_level,solver_version,status,est_cost,created_at,out_dir) "
                              "VALUES(?,?,?,?,?,?,?,?,'queued',?,") + kNow + ",?)");
   Stmt link(*db_, "INSERT OR IGNORE INTO campaign_cases(campaign_id,case_id,origin) VALUES(?,?,?)");
-  int added = 0;
+  int linked = 0;
   for (const auto& p : cases) {
     const std::string id = p.identity(version);
     ins.reset();
@@ -235,12 +303,12 @@ int Store::add_cases(std::int64_t campaign_id, const std::vector<CaseParams>& ca
     ins.bind(7, std::int64_t{p.mesh_level()}).bind(8, version).bind(9, p.estimated_cost());
     ins.bind(10, runs_dir + "/" + id);
     ins.step();
-    added += db_->changes();
     link.reset();
     link.bind(1, campaign_id).bind(2, id).bind(3, origin);
     link.step();
+    linked += db_->changes();
   }
-  return added;
+  return linked;
 }
 
 namespace {
@@ -271,6 +339,13 @@ std::vector<CaseRow> Store::campaign_cases(std::int64_t campaign_id) {
   std::vector<CaseRow> out;
   while (s.step()) out.push_back(read_case(s));
   return out;
+}
+
+std::optional<CaseState> Store::case_state(const std::string& case_id) {
+  Stmt s(*db_, "SELECT status, resumable, attempts, coalesce(error,'') FROM cases WHERE case_id=?");
+  s.bind(1, case_id);
+  if (!s.step()) return std::nullopt;
+  return CaseState{s.text(0), s.integer(1) != 0, static_cast<int>(s.integer(2)), s.text(3)};
 }
 
 std::vector<CaseRow> Store::running_cases() {
@@ -393,22 +468,141 @@ void Store::save_transitions(std::int64_t campaign_id, const std::vector<Transit
   Stmt d(*db_, "DELETE FROM transitions WHERE campaign_id=?");
   d.bind(1, campaign_id);
   d.step();
-  Stmt s(*db_, std::string("INSERT INTO transitions(campaign_id,law,aspect_ratio,skalak_C,mesh_level,d12_threshold,"
-                           "n_samples,ca_star_low,ca_star_high,ca_star_below,ca_star_above,ca_min_d12,ca_h,ca_h_low,"
-                           "ca_h_high,ca_h_low_case,ca_h_high_case,method,note,updated_at) "
-                           "VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,") + kNow + ")");
+  Stmt s(*db_, std::string("INSERT INTO transitions(campaign_id,group_key,law,aspect_ratio,skalak_C,mesh_level,"
+                           "d12_threshold,n_samples,ca_star_low,ca_star_high,ca_star_below,ca_star_above,ca_min_d12,"
+                           "ca_h,ca_h_low,ca_h_high,ca_h_low_case,ca_h_high_case,method,note,updated_at) "
+                           "VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,") + kNow + ")");
   auto opt_text = [](const std::string& x) { return x.empty() ? SqlValue{nullptr} : SqlValue{x}; };
   for (const auto& r : rows) {
     s.reset();
-    s.bind(1, campaign_id).bind(2, r.law).bind(3, r.aspect_ratio).bind(4, r.skalak_C);
-    s.bind(5, std::int64_t{r.mesh_level}).bind(6, r.d12_threshold).bind(7, std::int64_t{r.n_samples});
-    s.bind_opt(8, r.ca_star_low).bind_opt(9, r.ca_star_high).bind_opt(10, r.ca_star_below).bind_opt(11, r.ca_star_above);
-    s.bind_opt(12, r.ca_min_d12).bind_opt(13, r.ca_h).bind_opt(14, r.ca_h_low).bind_opt(15, r.ca_h_high);
-    s.bind(16, opt_text(r.ca_h_low_case)).bind(17, opt_text(r.ca_h_high_case));
-    s.bind(18, r.method).bind(19, r.note);
+    s.bind(1, campaign_id).bind(2, r.group_key).bind(3, r.law).bind(4, r.aspect_ratio).bind(5, r.skalak_C);
+    s.bind(6, std::int64_t{r.mesh_level}).bind(7, r.d12_threshold).bind(8, std::int64_t{r.n_samples});
+    s.bind_opt(9, r.ca_star_low).bind_opt(10, r.ca_star_high).bind_opt(11, r.ca_star_below);
+    s.bind_opt(12, r.ca_star_above).bind_opt(13, r.ca_min_d12).bind_opt(14, r.ca_h).bind_opt(15, r.ca_h_low);
+    s.bind_opt(16, r.ca_h_high).bind(17, opt_text(r.ca_h_low_case)).bind(18, opt_text(r.ca_h_high_case));
+    s.bind(19, r.method).bind(20, r.note);
     s.step();
   }
   t.commit();
+}
+
+std::vector<CaseSample> Store::campaign_samples(std::int64_t campaign_id) {
+  Stmt s(*db_,
+         "SELECT c.case_id, c.params_json, c.status, r.min_D12, r.max_tau_min "
+         "FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id LEFT JOIN results r ON r.case_id=c.case_id "
+         "WHERE cc.campaign_id=? ORDER BY c.law, c.aspect_ratio, coalesce(c.skalak_C,-1), c.mesh_level, "
+         "c.capillary_number");
+  s.bind(1, campaign_id);
+  std::vector<CaseSample> out;
+  while (s.step()) out.push_back({s.text(0), CaseParams::from_json(s.text(1)), s.text(2), s.real(3), s.real(4)});
+  return out;
+}
+
+std::vector<Transition> Store::transitions(std::int64_t campaign_id, int mesh_level, double skalak_C) {
+  const bool grouped = has_column(*db_, "transitions", "group_key");
+  Stmt s(*db_, std::string("SELECT ") + (grouped ? "group_key" : "''") +
+                   ", law, aspect_ratio, skalak_C, mesh_level, d12_threshold, n_samples, ca_star_low, ca_star_high, "
+                   "ca_star_below, ca_star_above, ca_min_d12, ca_h, ca_h_low, ca_h_high, coalesce(ca_h_low_case,''), "
+                   "coalesce(ca_h_high_case,''), method, note FROM transitions WHERE campaign_id=?1 "
+                   "AND (?2 < 0 OR mesh_level = ?2) AND (?3 < -0.5 OR skalak_C = ?3 OR law='neo-hookean') "
+                   "ORDER BY law, aspect_ratio, mesh_level DESC, 1");
+  s.bind(1, campaign_id).bind(2, std::int64_t{mesh_level}).bind(3, skalak_C);
+  std::vector<Transition> out;
+  while (s.step()) {
+    Transition t;
+    t.group_key = s.text(0);
+    t.law = s.text(1);
+    t.aspect_ratio = *s.real(2);
+    t.skalak_C = *s.real(3);
+    t.mesh_level = static_cast<int>(s.integer(4));
+    t.d12_threshold = *s.real(5);
+    t.n_samples = static_cast<int>(s.integer(6));
+    t.ca_star_low = s.real(7);
+    t.ca_star_high = s.real(8);
+    t.ca_star_below = s.real(9);
+    t.ca_star_above = s.real(10);
+    t.ca_min_d12 = s.real(11);
+    t.ca_h = s.real(12);
+    t.ca_h_low = s.real(13);
+    t.ca_h_high = s.real(14);
+    t.ca_h_low_case = s.text(15);
+    t.ca_h_high_case = s.text(16);
+    t.method = s.text(17);
+    t.note = s.text(18);
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
+std::optional<std::string> Store::campaign_spec_json(std::int64_t campaign_id) {
+  Stmt s(*db_, "SELECT spec_json FROM campaigns WHERE campaign_id=?");
+  s.bind(1, campaign_id);
+  if (!s.step()) return std::nullopt;
+  return s.text(0);
+}
+
+std::vector<CampaignInfo> Store::campaigns(const std::string& name) {
+  Stmt s(*db_, "SELECT campaign_id, name, updated_at FROM campaigns WHERE (?1 = '' OR name = ?1) ORDER BY campaign_id");
+  s.bind(1, name);
+  std::vector<CampaignInfo> out;
+  while (s.step()) out.push_back({s.integer(0), s.text(1), s.text(2)});
+  return out;
+}
+
+StatusCounts Store::status_counts(std::int64_t campaign_id) {
+  Stmt s(*db_, "SELECT c.status, count(*), sum(cc.origin='adaptive') FROM cases c JOIN campaign_cases cc "
+               "ON cc.case_id=c.case_id WHERE cc.campaign_id=? GROUP BY c.status");
+  s.bind(1, campaign_id);
+  StatusCounts n;
+  while (s.step()) {
+    n.by_status[s.text(0)] = s.integer(1);
+    n.total += s.integer(1);
+    n.adaptive += s.integer(2);
+  }
+  return n;
+}
+
+std::vector<ProblemCase> Store::problem_cases(std::int64_t campaign_id, int limit) {
+  Stmt s(*db_, "SELECT c.case_id, c.law, c.aspect_ratio, c.capillary_number, c.status, "
+               "coalesce(c.error,'') FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id "
+               "WHERE cc.campaign_id=? AND (c.status IN ('failed','unstable','running') OR "
+               "(c.status='queued' AND c.attempts>0)) ORDER BY c.status, c.law, c.aspect_ratio, "
+               "c.capillary_number LIMIT ?");
+  s.bind(1, campaign_id).bind(2, std::int64_t{limit});
+  std::vector<ProblemCase> out;
+  while (s.step()) {
+    ProblemCase p;
+    p.case_id = s.text(0);
+    p.law = s.text(1);
+    p.aspect_ratio = *s.real(2);
+    p.capillary_number = *s.real(3);
+    p.status = s.text(4);
+    p.error = s.text(5);
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+Table Store::cases_table(const CaseFilter& f) {
+  Stmt s(*db_,
+         "SELECT c.case_id, c.law, c.aspect_ratio, c.skalak_C, c.mesh_level, c.capillary_number, c.status, "
+         "c.attempts, r.min_D12, r.max_tau_min, r.mean_D12, r.period, r.regime, r.volume_drift, r.steps, "
+         "r.dt, r.t_final, coalesce(r.wall_s, c.wall_s) AS wall_s, c.code_version, c.error, c.h5_path "
+         "FROM cases c LEFT JOIN results r ON r.case_id=c.case_id "
+         "WHERE (?1 = '' OR c.case_id IN (SELECT cc.case_id FROM campaign_cases cc JOIN campaigns k "
+         "ON k.campaign_id=cc.campaign_id WHERE k.name=?1)) "
+         "AND (?2 = '' OR c.law = ?2) AND (?3 <= 0 OR abs(c.aspect_ratio - ?3) < 1e-12) "
+         "AND c.capillary_number >= ?4 AND c.capillary_number <= ?5 AND (?6 = '' OR c.status = ?6) "
+         "ORDER BY c.law, c.aspect_ratio, c.skalak_C, c.mesh_level, c.capillary_number");
+  s.bind(1, f.campaign).bind(2, f.law).bind(3, f.aspect_ratio).bind(4, f.ca_min).bind(5, f.ca_max).bind(6, f.status);
+  return read_table(s);
+}
+
+int Store::count_campaign_cases(std::int64_t campaign_id, const std::string& origin) {
+  Stmt s(*db_, "SELECT count(*) FROM campaign_cases WHERE campaign_id=? AND origin=?");
+  s.bind(1, campaign_id).bind(2, origin);
+  s.step();
+  return static_cast<int>(s.integer(0));
 }
 
 }  // namespace capsim::campaign

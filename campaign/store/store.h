@@ -1,15 +1,19 @@
 #pragma once
 /// @file
 /// @brief The campaign database: schema creation and version check, campaigns, cases, results,
-/// attempts and transitions. Only the campaign manager opens it for writing.
+/// attempts and transitions. Only the campaign manager opens it for writing. Every SQL statement of the
+/// campaign layer lives in this folder (store/); the other folders call typed functions. Layering:
+/// store -> analysis (the Transition / CaseSample value types), grid, common; never the reverse.
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "campaign/analysis/transitions.h"
 #include "campaign/grid/campaign_spec.h"
 #include "campaign/grid/case_params.h"
 #include "campaign/store/sqlite_db.h"
@@ -30,6 +34,14 @@ struct CaseRow {
   std::string error;         ///< last error text
 };
 
+/// @brief Where a case stands (dry runs).
+struct CaseState {
+  std::string status;        ///< queued | running | done | unstable | failed
+  bool resumable = false;    ///< a checkpoint exists
+  int attempts = 0;          ///< starts so far
+  std::string error;         ///< last error text
+};
+
 /// @brief The outcome of one worker as the manager saw it.
 struct WorkerOutcome {
   int exit_code = -1;        ///< exit status, or -1 when killed by a signal
@@ -39,22 +51,33 @@ struct WorkerOutcome {
   std::string stderr_tail;   ///< last lines of its stderr
 };
 
-/// @brief Critical capillary numbers of one (law, a/b, C, level) group.
-struct Transition {
-  std::string law;                     ///< membrane law
-  double aspect_ratio = 0;             ///< a/b
-  double skalak_C = -1;                ///< -1 for neo-hookean
-  int mesh_level = 0;                  ///< mesh level
-  double d12_threshold = 0.05;         ///< criterion used
-  int n_samples = 0;                   ///< finished samples used
-  std::optional<double> ca_star_low, ca_star_high;    ///< sampled Ca with min_D12 < threshold
-  std::optional<double> ca_star_below, ca_star_above; ///< nearest samples outside the interval
-  std::optional<double> ca_min_d12;    ///< sampled Ca of the smallest min_D12
-  std::optional<double> ca_h;          ///< interpolated zero of max_tau_min
-  std::optional<double> ca_h_low, ca_h_high;          ///< its bracket
-  std::string ca_h_low_case, ca_h_high_case;          ///< bracket case ids
-  std::string method = "grid";         ///< grid | adaptive
-  std::string note;                    ///< e.g. "CaH above sampled range"
+/// @brief A campaign's row (status listing).
+struct CampaignInfo {
+  std::int64_t campaign_id = 0;  ///< id
+  std::string name;              ///< unique name
+  std::string updated_at;        ///< last run
+};
+
+/// @brief Cases of a campaign per status.
+struct StatusCounts {
+  std::map<std::string, std::int64_t> by_status;  ///< status -> cases
+  std::int64_t total = 0;                         ///< all cases
+  std::int64_t adaptive = 0;                      ///< added by adaptive refinement
+};
+
+/// @brief A case that needs attention (failed, unstable, running, or queued after an attempt).
+struct ProblemCase {
+  std::string case_id, law, status, error;  ///< identity, law, status, last error
+  double aspect_ratio = 0, capillary_number = 0;  ///< a/b, Ca
+};
+
+/// @brief Filters of `capsim query cases` (empty / non-positive: no filter).
+struct CaseFilter {
+  std::string campaign;               ///< campaign name
+  std::string law;                    ///< membrane law
+  double aspect_ratio = 0;            ///< a/b (<= 0: any)
+  double ca_min = 0, ca_max = 1e300;  ///< Ca range
+  std::string status;                 ///< case status
 };
 
 /// @brief The campaign database.
@@ -62,7 +85,7 @@ class Store {
  public:
   /// @brief Opens for writing, creating the file and schema if needed (one transaction, before any
   /// worker). A database of an older schema version this build can migrate (1 -> 2: adds the Slurm
-  /// tables) is migrated in one transaction; a newer or unknown version is refused.
+  /// tables; 2 -> 3: transitions keyed by group) is migrated in one transaction; a newer or unknown version is refused.
   /// @throws BadInput for a corrupt/foreign file or a version it cannot read (nothing written).
   static std::unique_ptr<Store> open_for_write(const std::string& path);
   /// @brief Opens an existing database read-only (queries, status, dry runs). An older version that
@@ -70,8 +93,8 @@ class Store {
   static std::unique_ptr<Store> open_readonly(const std::string& path);
   /// @brief The schema version this build creates (parsed from the embedded DDL).
   static int expected_schema_version();
-  /// @brief The oldest schema version this build reads and migrates (the embedded DDL is additive and
-  /// idempotent from this version on: CREATE ... IF NOT EXISTS only).
+  /// @brief The oldest schema version this build reads and migrates (schemas/NNN_*.sql from NNN = this + 1
+  /// on are applied in order to migrate; an older file can be read as is where the query needs only its columns).
   static constexpr int kOldestMigratableVersion = 1;
 
   /// @brief The connection.
@@ -83,11 +106,14 @@ class Store {
   std::optional<std::int64_t> find_campaign(const std::string& name);
   /// @brief Name of the most recently updated campaign (for queries without --campaign).
   std::optional<std::string> latest_campaign();
-  /// @brief Adds cases (new rows queued) and links them to the campaign; returns how many were new rows.
+  /// @brief Adds cases (new rows queued) and links them to the campaign; returns how many were new to the
+  /// campaign (a case another campaign already holds is linked, and counts; one it holds already does not).
   int add_cases(std::int64_t campaign_id, const std::vector<CaseParams>& cases, const std::string& origin,
                 const std::string& runs_dir);
   /// @brief Cases of a campaign.
   std::vector<CaseRow> campaign_cases(std::int64_t campaign_id);
+  /// @brief The state of case @p case_id, nullopt if the database does not hold it.
+  std::optional<CaseState> case_state(const std::string& case_id);
   /// @brief Every case with status running (orphans after a manager crash).
   std::vector<CaseRow> running_cases();
 
@@ -103,13 +129,38 @@ class Store {
                              const std::string& h5_path, const CaseParams& params);
   /// @brief Requeues the failed cases of a campaign (--retry-failed); returns how many.
   int requeue_failed(std::int64_t campaign_id);
-  /// @brief Replaces the transitions of a campaign.
+  /// @brief Replaces the transitions of a campaign (one row per Transition::group_key).
   void save_transitions(std::int64_t campaign_id, const std::vector<Transition>& rows);
+  /// @brief Every case of a campaign with the metrics of its result (the input of the analysis).
+  std::vector<CaseSample> campaign_samples(std::int64_t campaign_id);
+  /// @brief The stored transitions of a campaign (finest level first within law and a/b), with @p mesh_level
+  /// (< 0: any) and @p skalak_C (< 0: any; neo-Hookean rows always) filters. A version-2 database has no
+  /// group_key column: its rows are one per law, a/b, C and level, and come back with group_key "".
+  std::vector<Transition> transitions(std::int64_t campaign_id, int mesh_level = -1, double skalak_C = -1);
+  /// @brief The spec JSON a campaign was registered with (nullopt: no such campaign).
+  std::optional<std::string> campaign_spec_json(std::int64_t campaign_id);
+  /// @brief Campaigns named @p name ("" all), by id.
+  std::vector<CampaignInfo> campaigns(const std::string& name);
+  /// @brief Cases of a campaign per status.
+  StatusCounts status_counts(std::int64_t campaign_id);
+  /// @brief Up to @p limit cases of a campaign that need attention, by status, law, a/b, Ca.
+  std::vector<ProblemCase> problem_cases(std::int64_t campaign_id, int limit);
+  /// @brief Cases with their results (`capsim query cases`).
+  Table cases_table(const CaseFilter& filter);
+  /// @brief Number of cases linked to a campaign with origin @p origin ("grid" | "adaptive").
+  int count_campaign_cases(std::int64_t campaign_id, const std::string& origin);
 
  private:
   explicit Store(std::unique_ptr<Db> db) : db_(std::move(db)) {}
   std::unique_ptr<Db> db_;
 };
+
+/// @brief Runs the user's SQL (`capsim query sql`): every statement is prepared first and, if any of them
+/// writes, none runs. Returns one table per statement that has result columns. @throws BadInput.
+std::vector<Table> run_readonly_sql(Db& db, const std::string& text);
+
+/// @brief Whether table @p table has column @p column.
+bool has_column(Db& db, const std::string& table, const std::string& column);
 
 /// @brief This machine's host name.
 std::string host_name();

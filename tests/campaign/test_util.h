@@ -20,7 +20,12 @@ namespace capsim::campaign::testing {
 
 namespace fs = std::filesystem;
 
-inline std::string exe() { return CAPSIM_EXE_PATH; }
+/// The capsim binary under test; CAPSIM_TEST_EXE overrides the one built with the tests (to check that a new
+/// test fails against an older binary, as every defect's test must).
+inline std::string exe() {
+  const char* e = std::getenv("CAPSIM_TEST_EXE");
+  return e && *e ? e : CAPSIM_EXE_PATH;
+}
 inline std::string fake_worker() { return std::string(CAPSIM_SOURCE_DIR) + "/tests/campaign/fake_worker.sh"; }
 
 /// A fresh folder per test under CAPSIM_TEST_TMP.

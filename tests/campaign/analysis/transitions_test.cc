@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "campaign/analysis/refinement.h"
 #include "campaign/analysis/transitions.h"
 
 namespace capsim::campaign {

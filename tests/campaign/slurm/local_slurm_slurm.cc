@@ -10,7 +10,7 @@
 #include <cmath>
 #include <regex>
 
-#include "test_util.h"
+#include "tests/campaign/test_util.h"
 
 namespace capsim::campaign::testing {
 namespace {

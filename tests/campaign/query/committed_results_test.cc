@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "test_util.h"
+#include "tests/campaign/test_util.h"
 
 namespace capsim::campaign::testing {
 namespace {

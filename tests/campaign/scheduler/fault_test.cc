@@ -8,7 +8,7 @@
 #include <set>
 
 #include "campaign/scheduler/worker_process.h"
-#include "test_util.h"
+#include "tests/campaign/test_util.h"
 
 namespace capsim::campaign::testing {
 namespace {

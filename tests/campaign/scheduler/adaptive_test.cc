@@ -4,7 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "test_util.h"
+#include "tests/campaign/test_util.h"
 
 namespace capsim::campaign::testing {
 namespace {
@@ -53,6 +53,42 @@ max_rounds = 20
   auto again = nlohmann::json::parse(sh(exe() + " query sql \"SELECT n_samples FROM transitions\" --db " + db +
                                         " --format json").out);
   EXPECT_EQ(again[0]["n_samples"].get<int>(), n);
+}
+
+// Issue 12, defect 6: a round reported the Ca values it proposed, also those whose case already exists (here an
+// unstable case at Ca = 0.15 is proposed again every round: it is no sample, yet its identity exists). The
+// reported counts must add up to the adaptive cases the database holds.
+TEST(Adaptive, RoundsReportTheCasesTheyAdded) {
+  const std::string dir = fresh_dir("adaptive_added");
+  const std::string db = dir + "/study.db";
+  write_file(dir + "/a.toml", R"([campaign]
+name = "adaptive-added"
+[defaults]
+mesh.level = 1
+[[grid]]
+aspect_ratio = [2.0]
+law = ["neo-hookean"]
+capillary_number = [0.1, 0.2, 0.3, 0.4]
+[analysis]
+adaptive = true
+ca_tolerance = 0.02
+max_rounds = 6
+)");
+  auto r = sh(campaign_cmd("FAKE_STEPS=1 FAKE_STEP_S=0.001 FAKE_UNSTABLE_CA=0.15", dir + "/a.toml", db, "--jobs 2"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  int reported = 0, rounds = 0;
+  const std::string tag = ": adaptive round ";
+  for (auto at = r.err.find(tag); at != std::string::npos; at = r.err.find(tag, at + 1)) {
+    const auto colon = r.err.find(": ", at + tag.size());
+    ASSERT_NE(colon, std::string::npos) << r.err;
+    reported += std::stoi(r.err.substr(colon + 2));
+    ++rounds;
+  }
+  ASSERT_GT(rounds, 0) << "no adaptive round ran:\n" << r.err;
+  const int in_db = std::stoi(sql(db, "SELECT count(*) FROM campaign_cases WHERE origin='adaptive'"));
+  EXPECT_EQ(reported, in_db) << r.err;
+  // The unstable case exists once; it is never proposed as a new case again.
+  EXPECT_EQ(std::stoi(sql(db, "SELECT count(*) FROM cases WHERE abs(capillary_number - 0.15) < 1e-12")), 1);
 }
 
 }  // namespace

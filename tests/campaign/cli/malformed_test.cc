@@ -1,7 +1,7 @@
 // Malformed campaign files: exit 2, one clear message naming the key or file, the database untouched.
 #include <gtest/gtest.h>
 
-#include "test_util.h"
+#include "tests/campaign/test_util.h"
 
 namespace capsim::campaign::testing {
 namespace {

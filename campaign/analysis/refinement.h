@@ -1,0 +1,24 @@
+#pragma once
+/// @file
+/// @brief The adaptive mode's refinement: which capillary numbers to add so the Ca* edges and the CaH
+/// bracket of each group shrink below the tolerance. Pure: the caller adds the cases to the store.
+
+#include <vector>
+
+#include "campaign/analysis/transitions.h"
+
+namespace capsim::campaign {
+
+/// @brief Capillary numbers to add to a group with transition @p t so its Ca* edges and CaH bracket shrink
+/// below @p tolerance; values are rounded to a decimal quantum below the tolerance and never repeat a Ca in
+/// @p existing (the group's cases, whatever their status) or each other.
+std::vector<double> propose_refinement(const Transition& t, std::vector<Sample> samples, double tolerance,
+                                       const std::vector<double>& existing = {});
+
+/// @brief One adaptive round: for each group (analysed with @p d12_threshold), the new cases its proposals
+/// give, at most @p budget in all (group order, then proposal order). Every returned case is new: a Ca
+/// whose case already exists in the group is not proposed.
+std::vector<CaseParams> refinement_round(const std::vector<SampleGroup>& groups, double d12_threshold,
+                                         double tolerance, int budget);
+
+}  // namespace capsim::campaign

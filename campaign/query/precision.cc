@@ -1,0 +1,35 @@
+#include "campaign/query/precision.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "campaign/grid/decimal.h"
+
+namespace capsim::campaign {
+
+std::string format_sampled(double x) { return canonical_double(x); }
+
+std::string format_significant(double x, int digits) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+  return buf;
+}
+
+std::string format_with_error(double x, double error) {
+  if (!(error > 0) || !std::isfinite(error) || !std::isfinite(x)) return format_significant(x, 3);
+  // The decimal exponent of the error's leading digit: 0.05 -> -2, 0.1 -> -1, 20 -> 1.
+  const int e = static_cast<int>(std::floor(std::log10(error)));
+  char buf[48];
+  if (e < 0) {
+    std::snprintf(buf, sizeof buf, "%.*f", -e, x);
+  } else {
+    const double q = std::pow(10.0, e);
+    std::snprintf(buf, sizeof buf, "%.0f", std::round(x / q) * q);
+  }
+  std::string s = buf;
+  // -0.00 after rounding is 0.00: a sign the digits do not support.
+  if (s[0] == '-' && s.find_first_not_of("-0.") == std::string::npos) s = s.substr(1);
+  return s;
+}
+
+}  // namespace capsim::campaign

@@ -1,0 +1,51 @@
+// Issue 12, defect 8: transitions are computed per group of cases that agree in every identity key but Ca.
+// A grid axis over a numerical key (here time.dt) must give one Ca* / CaH per value, not a pooled one.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/campaign/test_util.h"
+
+namespace capsim::campaign::testing {
+namespace {
+
+TEST(TransitionGroups, NumericsAxisGivesOneTransitionPerValue) {
+  const std::string dir = fresh_dir("transition_groups");
+  const std::string db = dir + "/study.db";
+  write_file(dir + "/g.toml", R"([campaign]
+name = "dt-axis"
+[defaults]
+mesh.level = 1
+[[grid]]
+aspect_ratio = [2.0]
+law = ["neo-hookean"]
+time.dt = [0.01, 0.02]
+capillary_number = [0.1, 0.2, 0.3, 0.4]
+)");
+  auto r = sh(campaign_cmd("FAKE_STEPS=1 FAKE_STEP_S=0.001", dir + "/g.toml", db, "--jobs 2"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto t = sh(exe() + " query sql \"SELECT * FROM transitions ORDER BY group_key\" --db " + db + " --format json");
+  ASSERT_EQ(t.code, 0) << t.err;
+  const auto rows = nlohmann::json::parse(t.out);
+  ASSERT_EQ(rows.size(), 2u) << t.out;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& row = rows[i];
+    EXPECT_EQ(row["n_samples"].get<int>(), 4) << "each dt has its own four samples";
+    // The group names its keys: every identity key except Ca, as canonical JSON.
+    const auto key = nlohmann::json::parse(row["group_key"].get<std::string>());
+    EXPECT_FALSE(key.contains("flow.capillary_number"));
+    EXPECT_EQ(key.at("capsule.law"), "neo-hookean");
+    EXPECT_DOUBLE_EQ(key.at("time.dt").get<double>(), i == 0 ? 0.01 : 0.02);
+    // Fake worker truth for a/b >= 1: min_D12 < 0.05 for |Ca - 0.225| < 0.06, CaH = 0.35.
+    EXPECT_DOUBLE_EQ(row["ca_star_low"].get<double>(), 0.2);
+    EXPECT_DOUBLE_EQ(row["ca_star_high"].get<double>(), 0.2);
+    EXPECT_NEAR(row["ca_h"].get<double>(), 0.35, 1e-12);
+  }
+  // Table 1 cannot show two groups in one cell: it says so (bad input), it does not pick one.
+  auto q = sh(exe() + " query table1 --db " + db);
+  EXPECT_EQ(q.code, 2) << q.out;
+  EXPECT_NE(q.err.find("time.dt"), std::string::npos) << q.err;
+}
+
+}  // namespace
+}  // namespace capsim::campaign::testing

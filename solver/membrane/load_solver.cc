@@ -1,5 +1,6 @@
 #include "solver/membrane/load_solver.h"
 
+#include <array>
 #include <stdexcept>
 #include <string>
 
@@ -13,7 +14,8 @@ namespace capsim::membrane {
 
 struct LoadSolver::Impl {
   Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> cholmod;
-  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
+  // One CG per load component, so the three solves run side by side in one parallel region (below).
+  std::array<Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper>, 3> cg;
   std::vector<std::array<double, 6>> N;                      // per rule point
   std::vector<std::array<std::array<double, 6>, 2>> dN;      // per rule point
   std::vector<double> w;                                     // rule weights · ½
@@ -88,8 +90,10 @@ void LoadSolver::factorize() {
     if (impl_->cholmod.info() != Eigen::Success)
       throw std::runtime_error("CHOLMOD: the mass matrix is not positive definite (surface degenerated)");
   } else {
-    impl_->cg.setTolerance(options_.cg_tolerance);
-    impl_->cg.compute(M_);
+    for (auto& cg : impl_->cg) {
+      cg.setTolerance(options_.cg_tolerance);
+      cg.compute(M_);
+    }
   }
 }
 
@@ -99,12 +103,20 @@ void LoadSolver::solve(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
     q = impl_->cholmod.solve(rhs).transpose();
     last_iterations_ = 0;
   } else {
+    // The three components are independent solves: one parallel region for all of them, each CG serial
+    // inside it (Eigen's own parallel product is skipped in a nested region). Left to Eigen, every CG
+    // iteration opens its own parallel region for one sparse product (≈ 80 tiny regions per load solve); with
+    // OpenMP's spin-waiting those regions collapse when another process shares the cores (issue 12 item 13,
+    // results/benchmarks.md). A row of the product is summed in the same order either way, so q is bitwise
+    // the same as with Eigen's threaded product, for any thread count.
     Eigen::MatrixX3d sol(R.cols(), 3);
-    last_iterations_ = 0;
+    int iterations[3] = {0, 0, 0};
+#pragma omp parallel for schedule(static, 1)
     for (int c = 0; c < 3; ++c) {
-      sol.col(c) = impl_->cg.solve(rhs.col(c));
-      last_iterations_ += static_cast<int>(impl_->cg.iterations());
+      sol.col(c) = impl_->cg[c].solve(rhs.col(c));
+      iterations[c] = static_cast<int>(impl_->cg[c].iterations());
     }
+    last_iterations_ = iterations[0] + iterations[1] + iterations[2];
     q = sol.transpose();
   }
 }

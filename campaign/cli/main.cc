@@ -1,5 +1,8 @@
 // The `capsim` executable: a thin dispatcher over the sub-commands in commands.h.
+#include <unistd.h>
+
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <string>
 #include <vector>
@@ -26,9 +29,22 @@ void print_usage() {
       capsim::kVersion, capsim::kGitCommit);
 }
 
+// OpenMP threads that spin while they wait for work take the cores from whatever else runs on them: with GNU
+// OpenMP's default (spinning) wait, a case beside a second one slows down many times more than the sharing
+// explains (measured in results/benchmarks.md, "Sharing the cores"). Campaign workers, Slurm tasks and users
+// share cores all the time, so capsim waits passively unless the user chose otherwise. libgomp reads
+// OMP_WAIT_POLICY once, when the program is loaded, so the only way to set it from inside is to set it and
+// start this program again (once: the variable is then set). If the re-exec fails, capsim runs as it is.
+void wait_passively_unless_told_otherwise(char** argv) {
+  if (std::getenv("OMP_WAIT_POLICY") != nullptr) return;
+  setenv("OMP_WAIT_POLICY", "passive", 1);
+  execv("/proc/self/exe", argv);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  wait_passively_unless_told_otherwise(argv);
   if (argc < 2) {
     print_usage();
     return capsim::kExitBadInput;

@@ -1,5 +1,6 @@
 #include "solver/membrane/load_solver.h"
 
+#include <array>
 #include <stdexcept>
 #include <string>
 
@@ -13,7 +14,8 @@ namespace capsim::membrane {
 
 struct LoadSolver::Impl {
   Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> cholmod;
-  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
+  // One CG per load component, so the three solves run side by side in one parallel region (below).
+  std::array<Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper>, 3> cg;
   mesh::P2Tabulation p2;                                     // the rule's points
 };
 
@@ -77,8 +79,10 @@ void LoadSolver::factorize() {
     if (impl_->cholmod.info() != Eigen::Success)
       throw DegenerateSurface("CHOLMOD: the mass matrix is not positive definite (surface degenerated)");
   } else {
-    impl_->cg.setTolerance(options_.cg_tolerance);
-    impl_->cg.compute(M_);
+    for (auto& cg : impl_->cg) {
+      cg.setTolerance(options_.cg_tolerance);
+      cg.compute(M_);
+    }
   }
 }
 
@@ -90,18 +94,30 @@ void LoadSolver::solve(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
     // CHOLMOD's positive-definiteness test lets a NaN matrix through (NaN pivots compare false).
     if (!q.allFinite()) throw DegenerateSurface("CHOLMOD: non-finite load (surface degenerated)");
   } else {
+    // The three components are independent solves: one parallel region for all of them, each CG serial
+    // inside it (Eigen's own parallel product is skipped in a nested region). Left to Eigen, every CG
+    // iteration opens its own parallel region for one sparse product (≈ 80 tiny regions per load solve); with
+    // OpenMP's spin-waiting those regions collapse when another process shares the cores (issue 12 item 13,
+    // results/benchmarks.md). A row of the product is summed in the same order either way, so q is bitwise
+    // the same as with Eigen's threaded product, for any thread count.
     Eigen::MatrixX3d sol(R.cols(), 3);
-    last_iterations_ = 0;
+    int iterations[3] = {0, 0, 0};
+    bool converged[3] = {false, false, false};
+#pragma omp parallel for schedule(static, 1)
     for (int c = 0; c < 3; ++c) {
-      sol.col(c) = impl_->cg.solve(rhs.col(c));
-      last_iterations_ += static_cast<int>(impl_->cg.iterations());
-      // M is SPD with a condition number bounded independently of h on any valid surface, so CG converges
-      // in a few dozen iterations; not converging means M is not SPD (a NaN position, a collapsed surface).
-      if (impl_->cg.info() != Eigen::Success || !sol.col(c).allFinite())
-        throw DegenerateSurface("CG: the load solve did not converge (residual " + std::to_string(impl_->cg.error()) +
-                                " after " + std::to_string(impl_->cg.iterations()) +
-                                " iterations): the mass matrix is not positive definite (surface degenerated)");
+      sol.col(c) = impl_->cg[c].solve(rhs.col(c));
+      iterations[c] = static_cast<int>(impl_->cg[c].iterations());
+      converged[c] = impl_->cg[c].info() == Eigen::Success && sol.col(c).allFinite();
     }
+    last_iterations_ = iterations[0] + iterations[1] + iterations[2];
+    // M is SPD with a condition number bounded independently of h on any valid surface, so CG converges in
+    // a few dozen iterations; not converging means M is not SPD (a NaN position, a collapsed surface).
+    // (Thrown here, not inside the parallel region, which an exception must not leave.)
+    for (int c = 0; c < 3; ++c)
+      if (!converged[c])
+        throw DegenerateSurface("CG: the load solve did not converge (residual " + std::to_string(impl_->cg[c].error()) +
+                                " after " + std::to_string(impl_->cg[c].iterations()) +
+                                " iterations): the mass matrix is not positive definite (surface degenerated)");
     q = sol.transpose();
   }
 }

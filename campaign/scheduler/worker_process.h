@@ -22,7 +22,7 @@ struct WorkerCommand {
 /// @brief The worker executable: $CAPSIM_WORKER if set, else this program (/proc/self/exe).
 std::string default_worker_executable();
 
-/// @brief Arguments of `capsim run` for a case folder (the contract of DESIGN.md section 8).
+/// @brief Arguments of `capsim run` for a case folder (the contract of campaign/README.md, "The worker contract").
 std::vector<std::string> worker_args(const std::string& case_toml, const std::string& out_dir, int threads, bool resume);
 
 /// @brief fork+exec of a worker in its own process group, with SIGTERM as parent-death signal (so a

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// @brief Periodic-regime analysis of the diagnostics time series: period, min D12, max τmin, mean D12 over
-/// the last full period, the regime (tumbling / swinging / steady), and the stopping test of DESIGN.md §4.
+/// the last full period, the regime (tumbling / swinging / steady), and the stopping test of solver/README.md §4.
 ///
 /// What "period" means here. The capsule (a spheroid, centrally symmetric) in linear shear keeps its central
 /// symmetry x → −x, so its shape repeats after half a material revolution: a tumbling capsule's long axis
@@ -155,7 +155,7 @@ PeriodAnalysis analyse_periods(std::span<const double> t, std::span<const double
 /// @brief Same, on a TimeSeries.
 PeriodAnalysis analyse_periods(const TimeSeries& series, const PeriodOptions& options = {});
 
-/// @brief The stopping test of DESIGN.md §4: true when the regime is steady, or periodic (tumbling or
+/// @brief The stopping test of solver/README.md §4: true when the regime is steady, or periodic (tumbling or
 /// swinging) with the last `periods` full periods agreeing pairwise on min D12, max τmin and the period.
 bool periodic_regime_converged(const PeriodAnalysis& analysis, const ConvergenceOptions& options = {});
 

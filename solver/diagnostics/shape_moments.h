@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// @brief Volume, area, centroid and second moments of the region enclosed by a closed P2 surface, and its
-/// ellipsoid of inertia in the shear plane (DESIGN.md §5; seed paper §3.1, eq. 11).
+/// ellipsoid of inertia in the shear plane (solver/README.md §5; seed paper §3.1, eq. 11).
 
 #include <Eigen/Core>
 

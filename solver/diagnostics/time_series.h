@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief The per-step diagnostics of one case (seed §3: D12, θ, τmin, P; DESIGN.md §5) and their time series.
+/// @brief The per-step diagnostics of one case (seed §3: D12, θ, τmin, P; solver/README.md §5) and their time series.
 
 #include <array>
 #include <cstddef>

@@ -143,7 +143,7 @@ nlohmann::json CaseSummary::to_json() const {
       {"status", status},
       {"reason", reason},
       {"capillary_number", parameters.capillary_number},
-      {"Ca", parameters.capillary_number},  // the name DESIGN.md §8 promises; capillary_number is the long one
+      {"Ca", parameters.capillary_number},  // the name campaign/README.md, "The worker contract" promises; capillary_number is the long one
       {"aspect_ratio", parameters.aspect_ratio},
       {"law", parameters.law},
       {"skalak_C", parameters.skalak_C},

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// @brief The summary of one case: its parameters and every result field, in one struct with one
-/// serialisation. It is the worker contract (DESIGN.md §8): `capsim run --json` prints to_json() as its last
+/// serialisation. It is the worker contract (campaign/README.md, "The worker contract"): `capsim run --json` prints to_json() as its last
 /// stdout line, the driver stores it as the root attributes of case.h5 (summary_attributes), and the
 /// campaign store and Slurm collect read worker lines back with from_json(). Adding a result field is one
 /// member here plus one line in the field list of case_summary.cc; adding a PeriodAnalysis field is one line

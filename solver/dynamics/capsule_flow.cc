@@ -59,7 +59,7 @@ FlowEvaluation CapsuleFlow::velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd
   timings_.stokes_s += seconds_since(t0);
   out.used_symmetry = single_layer_->last_stats().used_symmetry;
 
-  // v = v∞ − u/(8π Ca): the membrane pushes the fluid with −q (DESIGN.md §3).
+  // v = v∞ − u/(8π Ca): the membrane pushes the fluid with −q (solver/README.md §3).
   const double factor = -1.0 / (8.0 * std::numbers::pi * Ca_);
   v = factor * u_;
   out.max_speed = v.colwise().norm().maxCoeff();

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief The capsule's velocity field dx/dt = v(x) (DESIGN.md §2–§3): on positions x, the membrane gives
+/// @brief The capsule's velocity field dx/dt = v(x) (solver/README.md §2–§3): on positions x, the membrane gives
 /// the load q (M q = ∂W/∂x), and the single-layer integral gives
 ///   v(x0) = v∞(x0) − 1/(8π Ca) ∫_S J(x0, x)·q(x) dS,   v∞ = (x2, 0, 0).
 /// One call of `velocity` is one "flow evaluation", the unit of cost of the time integrators.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief Explicit time integrators on dx/dt = v(x) (DESIGN.md §4), selected by `time.scheme`:
+/// @brief Explicit time integrators on dx/dt = v(x) (solver/README.md §4), selected by `time.scheme`:
 ///  - "rk2": Heun, k1 = v(x_n), k2 = v(x_n + dt k1), x_{n+1} = x_n + dt/2 (k1 + k2). Second order, two flow
 ///    evaluations per step, stable for dt ρ ≤ 2 on the (nearly real, negative) membrane spectrum, i.e.
 ///    dt ≲ 0.33 Ca h_min: see automatic_time_step.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief The membrane load q from the weak equilibrium M q = R (DESIGN.md §2), where
+/// @brief The membrane load q from the weak equilibrium M q = R (solver/README.md §2), where
 /// M_ab = ∫_S φ_a φ_b dS is the P2 mass matrix on the *deformed* surface and R = ∂W/∂x.
 /// q is the load the fluids exert on the membrane (∇s·τ + q = 0): outward on an inflated sphere.
 

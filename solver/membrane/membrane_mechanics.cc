@@ -102,7 +102,7 @@ MembraneState MembraneMechanics::evaluate(const Eigen::Matrix3Xd& x) const {
     const EnergyDerivatives d = law_.derivatives(inv.I1, inv.Js);
     const auto tau = std::array<double, 2>{2.0 * d.d_I1 * inv.l1 / inv.l2 + d.d_Js, 2.0 * d.d_I1 * inv.l2 / inv.l1 + d.d_Js};
     // λ1 ≥ λ2 does not order the tensions: Skalak's τ1 − τ2 = (λ1² + λ2² − 1)(λ1/λ2 − λ2/λ1) is negative
-    // under strong compression (DESIGN.md §2), so both are compared.
+    // under strong compression (solver/README.md §2), so both are compared.
     s.tau_min = std::min({s.tau_min, tau[0], tau[1]});
     s.tau_max = std::max({s.tau_max, tau[0], tau[1]});
     // A^{αβ} = 2 ws_I1 G^{αβ} + ws_J Js g^{αβ}, with g^{αβ} the inverse current metric.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief Finite-element mechanics of the capsule membrane on P2 isoparametric triangles (DESIGN.md §2).
+/// @brief Finite-element mechanics of the capsule membrane on P2 isoparametric triangles (solver/README.md §2).
 ///
 /// The reference state X (the initial spheroid) is stress free. At each quadrature point the covariant
 /// tangents G_α = ∂X/∂ξ_α and g_α = ∂x/∂ξ_α give the metrics G_αβ, g_αβ; the surface Cauchy-Green tensor

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// @brief Closed P2 surface meshes of the capsule: a subdivided icosahedron on the unit sphere, mapped to a
-/// spheroid of revolution about x1 with semi-axes (a, b, b), a/b = r, a b² = 1 (DESIGN.md §1–§2).
+/// spheroid of revolution about x1 with semi-axes (a, b, b), a/b = r, a b² = 1 (solver/README.md §1–§2).
 
 #include <array>
 #include <cstdint>

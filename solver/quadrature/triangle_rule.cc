@@ -133,7 +133,7 @@ TriangleRule make_degree2() {
 }
 
 TriangleRule make_degree4() {
-  // Dunavant (1985), 6 points (DESIGN.md §6).
+  // Dunavant (1985), 6 points (solver/README.md §6).
   return polish(4, {{3, 0.223381589678011, 0.108103018168070, 0.0},
                     {3, 0.109951743655322, 0.816847572980459, 0.0}});
 }
@@ -147,7 +147,7 @@ TriangleRule make_degree5() {
 }
 
 TriangleRule make_degree6() {
-  // Dunavant (1985), 12 points (DESIGN.md §6).
+  // Dunavant (1985), 12 points (solver/README.md §6).
   return polish(6, {{3, 0.116786275726379, 0.501426509658179, 0.0},
                     {3, 0.050844906370207, 0.873821971016996, 0.0},
                     {6, 0.082851075618374, 0.053145049844817, 0.310352451033784}});

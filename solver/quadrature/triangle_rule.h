@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief Symmetric triangle quadrature rules with positive weights (Dunavant / Radon), DESIGN.md §6.
+/// @brief Symmetric triangle quadrature rules with positive weights (Dunavant / Radon), solver/README.md §6.
 
 #include <array>
 #include <span>

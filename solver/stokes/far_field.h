@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief The far-field tier of the single-layer operator (Options::far_degree > 0; DESIGN.md §3).
+/// @brief The far-field tier of the single-layer operator (Options::far_degree > 0; solver/README.md §3).
 ///
 /// The all-pairs sum uses a coarse rule (degree 1: centroid, or 2: 3 points) on every element. An element e
 /// is "far" from a target x0 when |x0 − c_e| > far_radius · ρ_e (c_e the mean of its 6 nodes, ρ_e their

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief The near-singular part of the single-layer operator (DESIGN.md §3). Elements that share a vertex
+/// @brief The near-singular part of the single-layer operator (solver/README.md §3). Elements that share a vertex
 /// with an element containing the target (but do not contain it) are close to it — h/2 for a mid-side
 /// node — and the regular rule's error there is O(h). Their regular-rule contribution is replaced by a
 /// subdivided rule. The neighbour lists depend on connectivity only.

@@ -1,13 +1,13 @@
 #pragma once
 /// @file
-/// @brief The single-layer boundary integral of the capsule's flow (DESIGN.md §3).
+/// @brief The single-layer boundary integral of the capsule's flow (solver/README.md §3).
 ///
 /// At every node x0 of the surface mesh, SingleLayer::apply computes
 ///     u(x0) = ∫_S J(x0, x)·q(x) dS(x),   J = I/r + r r/r³,  r = x0 − x,
 /// with x and q the P2 interpolants of the nodal positions and nodal loads over each element. It does NOT
 /// include the physical prefactor: the dynamics forms the velocity as
 ///     v(x0) = v∞(x0) − u(x0) / (8π Ca)
-/// (q = load the fluids exert on the membrane, so the membrane pushes the fluid with −q; DESIGN.md §3).
+/// (q = load the fluids exert on the membrane, so the membrane pushes the fluid with −q; solver/README.md §3).
 /// Identity for tests: on the unit sphere, a uniform q = f gives u = (16π/3) f, i.e. v − v∞ = −2f/(3Ca).
 ///
 /// Method, in the order apply() runs its phases:

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief The singular rules of the single-layer operator (DESIGN.md §3): for each of the six local node
+/// @brief The singular rules of the single-layer operator (solver/README.md §3): for each of the six local node
 /// positions of a P2 element, a Duffy (collapsed-square) rule with that node at the apex on the reference
 /// triangle, and its structure-of-arrays table for the vectorised correction loop.
 ///

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief The two primitives every phase of the single-layer operator is built from (DESIGN.md §3):
+/// @brief The two primitives every phase of the single-layer operator is built from (solver/README.md §3):
 /// laying out the points of a rule on every element as structure-of-arrays sources (position, and load
 /// weighted by the rule weight and the area element), and summing a short contiguous block of such sources
 /// for one target with the scalar Stokeslet.

@@ -1,4 +1,4 @@
-// Cost of one flow evaluation (membrane → load → boundary integral, DESIGN.md §2–§3) against the number of
+// Cost of one flow evaluation (membrane → load → boundary integral, solver/README.md §2–§3) against the number of
 // nodes N (mesh levels 1–5), on 1 and 2 OpenMP threads, split into the named phases of CapsuleFlow; and the
 // OpenMP efficiency t(1)/(2 t(2)). The capsule is a/b = 2, Skalak, Ca = 0.3, deformed so that the mirror
 // symmetry does not apply (the general case; with symmetry the boundary integral costs about half).

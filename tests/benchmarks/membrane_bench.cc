@@ -1,4 +1,4 @@
-// One membrane load evaluation (DESIGN.md §2) split into its phases, at levels 3 and 4:
+// One membrane load evaluation (solver/README.md §2) split into its phases, at levels 3 and 4:
 // kinematics + energy gradient R, mass-matrix assembly, CHOLMOD numeric factorisation (symbolic analysis is
 // cached), triangular solves; and the conjugate-gradient alternative for the same M q = R.
 #include <benchmark/benchmark.h>

@@ -1,4 +1,4 @@
-// Shape moments and ellipsoid of inertia on meshed spheres and spheroids (DESIGN.md §5).
+// Shape moments and ellipsoid of inertia on meshed spheres and spheroids (solver/README.md §5).
 #include "solver/diagnostics/shape_moments.h"
 
 #include <cmath>
@@ -58,7 +58,7 @@ TEST(ShapeMoments, SphereIsCentredAndIsotropic) {
   EXPECT_LT(err.back(), 2e-6);
 }
 
-// Spheroids a/b = 2 (prolate) and 0.5 (oblate), both D12 = 1/3 in the shear plane (DESIGN.md §1).
+// Spheroids a/b = 2 (prolate) and 0.5 (oblate), both D12 = 1/3 in the shear plane (solver/README.md §1).
 class SpheroidMoments : public ::testing::TestWithParam<double> {};
 
 TEST_P(SpheroidMoments, EllipsoidOfInertiaRecoversSemiAxesAndD12) {

@@ -51,7 +51,7 @@ TEST(CaseSummary, JsonRoundTripKeepsEveryField) {
   EXPECT_EQ(t.wrinkle_max.load_roughness, 0.4);
 }
 
-// The keys DESIGN.md §8 and the scripts rely on.
+// The keys campaign/README.md, "The worker contract" and the scripts rely on.
 TEST(CaseSummary, JsonHasTheContractKeys) {
   const nlohmann::json j = example().to_json();
   for (const char* key : {"status", "reason", "Ca", "capillary_number", "aspect_ratio", "law", "skalak_C",

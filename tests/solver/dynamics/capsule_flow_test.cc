@@ -20,7 +20,7 @@ config::CaseConfig sphere_case(int level, double Ca) {
   return c;
 }
 
-// Sign of the coupling (DESIGN.md §3): a capsule stretched away from its reference shape in fluid at rest
+// Sign of the coupling (solver/README.md §3): a capsule stretched away from its reference shape in fluid at rest
 // must relax back, its elastic energy decreasing monotonically towards zero.
 TEST(CapsuleFlow, StretchedCapsuleRelaxesInFluidAtRest) {
   CapsuleFlow flow(sphere_case(2, 0.1));

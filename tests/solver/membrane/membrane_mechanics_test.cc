@@ -186,7 +186,7 @@ TEST(LoadSolver, CholmodAndConjugateGradientAgree) {
   EXPECT_NEAR(direct.mass_matrix().sum(), area_and_volume(m, x).area, 1e-12);
 }
 
-// DESIGN.md §2: the tension along the larger stretch is not always the larger one. Skalak's
+// solver/README.md §2: the tension along the larger stretch is not always the larger one. Skalak's
 // τ1 − τ2 = (λ1² + λ2² − 1)(λ1/λ2 − λ2/λ1) changes sign when λ1² + λ2² < 1 (strong compression), so
 // τmin must be the smaller of the two, not the second. An anisotropic compression of the sphere by
 // 0.5–0.7 puts every quadrature point in that state.

@@ -9,7 +9,7 @@
 ///  - the compressed area fraction: the share of the current surface where τ2 < 0;
 ///  - the load roughness: RMS over the nodes of (q·n)_i minus its average over the node's mesh neighbours,
 ///    divided by the RMS of q·n. For a smooth load the difference is O(h²) (a discrete Laplacian), so the
-///    roughness falls ≈ 4× per mesh level; mesh-scale oscillations (wrinkles, an incipient instability) make
+///    roughness falls like h² (about 4× per mesh level); mesh-scale oscillations (wrinkles, an incipient instability) make
 ///    it O(1).
 
 #include <span>

@@ -93,8 +93,8 @@ class CapsuleFlow {
 ///
 /// Why: the stiff part of dv/dx is the membrane relaxation of the shortest resolved wavelengths, with
 /// nearly real eigenvalues of modulus ρ ≈ C (1 + 0.4 τmax)/(Ca h_min), C = 5.1–6.1 (power iteration, see
-/// membrane_spectral_radius); Heun's real stability interval is 2, so dt ≤ 2/ρ ≈ 0.33–0.39 Ca h_min at small
-/// Ca. At large Ca the prestress τmax (∝ Ca once the capsule is deformed) stiffens these modes: the limit
+/// membrane_spectral_radius); Heun's real stability interval is 2, so dt ≤ 2/ρ, about a third of Ca h_min at
+/// small Ca. At large Ca the prestress τmax (∝ Ca once the capsule is deformed) stiffens these modes: the limit
 /// becomes ∝ h_min alone (a CFL-like bound, but set by tension, not by advection: nodes move with the
 /// material). Measured limit of dt/(Ca h_min) (RK2, Skalak C = 1, shear flow, 5% initial stretch + 1e-6 h_min
 /// noise on every node, γ̇t = 3 or 1000 steps (600 at level 3), whichever first; blow-up = collapsed element,

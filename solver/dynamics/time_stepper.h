@@ -3,7 +3,7 @@
 /// @brief Explicit time integrators on dx/dt = v(x) (solver/README.md §4), selected by `time.scheme`:
 ///  - "rk2": Heun, k1 = v(x_n), k2 = v(x_n + dt k1), x_{n+1} = x_n + dt/2 (k1 + k2). Second order, two flow
 ///    evaluations per step, stable for dt ρ ≤ 2 on the (nearly real, negative) membrane spectrum, i.e.
-///    dt ≲ 0.33 Ca h_min: see automatic_time_step.
+///    dt of about Ca h_min / 3: see automatic_time_step.
 ///  - "rkc": the damped second-order Runge–Kutta–Chebyshev method (van der Houwen & Sommeijer 1980;
 ///    Verwer 1996; Sommeijer, Shampine & Verwer 1998, J. Comput. Appl. Math. 88, 315). s stages, s flow
 ///    evaluations per step, second order for every s, real stability interval β(s) ≈ 0.653 s² (damping

@@ -27,10 +27,10 @@ class LoadSolver {
     ConjugateGradient,  ///< Jacobi-preconditioned CG from a zero initial guess (deterministic, so a resumed
                         ///< run repeats an uninterrupted one bitwise)
   };
-  /// The default is CG: a mass matrix has a condition number bounded independently of h, so CG converges in
-  /// ≈ 26 iterations per component at every level, and at level 3 (4) it took 1.1 ms (4.4 ms) of CPU against
-  /// 3.3 ms (20.7 ms) for CHOLMOD's numeric factorisation + solves with Debian's reference BLAS
-  /// (tests/benchmarks/membrane_bench.cc).
+  /// The default is CG: a mass matrix has a condition number bounded independently of h, so CG needs the
+  /// same few dozen iterations at every level and is several times faster than CHOLMOD's numeric
+  /// factorisation + solves with Debian's reference BLAS (tests/benchmarks/membrane_bench.cc; the numbers are
+  /// in results/benchmarks.md).
   struct Options {
     Backend backend = Backend::ConjugateGradient;
     int quadrature_degree = 6;      ///< exact for P2×P2 on flat elements

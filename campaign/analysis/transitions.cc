@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "campaign/grid/decimal.h"
+#include "campaign/grid/precision.h"
 
 namespace capsim::campaign {
 
@@ -47,8 +48,8 @@ Transition analyse_group(Transition t, std::vector<Sample> samples, double thr) 
       if (first == 0) notes.push_back("Ca* interval starts at the smallest sampled Ca");
       if (last + 1 == static_cast<int>(d12.size())) notes.push_back("Ca* interval ends at the largest sampled Ca");
     } else {
-      notes.push_back("min_D12 never below " + canonical_double(thr) + " (smallest " +
-                      canonical_double(*best->min_d12) + " at Ca=" + canonical_double(best->ca) + ")");
+      notes.push_back("min_D12 never below " + format_sampled(thr) + " (smallest " +
+                      format_significant(*best->min_d12) + " at Ca=" + format_sampled(best->ca) + ")");
     }
   }
 
@@ -61,11 +62,11 @@ Transition analyse_group(Transition t, std::vector<Sample> samples, double thr) 
     for (int i = 0; i < static_cast<int>(tau.size()); ++i)
       if (*tau[i]->max_tau_min >= 0) last_pos = i;
     if (last_pos < 0) {
-      notes.push_back("max_tau_min < 0 at every sampled Ca: CaH below " + canonical_double(tau.front()->ca));
+      notes.push_back("max_tau_min < 0 at every sampled Ca: CaH below " + format_sampled(tau.front()->ca));
       t.ca_h_high = tau.front()->ca;
       t.ca_h_high_case = tau.front()->case_id;
     } else if (last_pos + 1 == static_cast<int>(tau.size())) {
-      notes.push_back("max_tau_min >= 0 at the largest sampled Ca: CaH above " + canonical_double(tau.back()->ca));
+      notes.push_back("max_tau_min >= 0 at the largest sampled Ca: CaH above " + format_sampled(tau.back()->ca));
       t.ca_h_low = tau.back()->ca;
       t.ca_h_low_case = tau.back()->case_id;
     } else {

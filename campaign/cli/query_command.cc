@@ -12,7 +12,7 @@
 #include "campaign/cli/commands.h"
 #include "campaign/common/bad_input.h"
 #include "campaign/grid/decimal.h"
-#include "campaign/query/precision.h"
+#include "campaign/grid/precision.h"
 #include "campaign/query/table_output.h"
 #include "campaign/store/store.h"
 

@@ -34,6 +34,15 @@ TEST(Transitions, CaStarIsTheSampledIntervalBelowThreshold) {
   EXPECT_DOUBLE_EQ(*u.ca_star_high, 0.03);
 }
 
+// The notes are printed (campaign status, the main command): numbers to 3 significant digits and sampled Ca as
+// sampled, never the 17 digits of a double (issue 12 §3).
+TEST(Transitions, NotesPrintNumbersToTheirPrecision) {
+  std::vector<Sample> s = {{0.4, 0.44971266940321575, 0.01, "a"}, {0.5, 0.49025674011763399, -0.01, "b"}};
+  const Transition t = analyse_group(Transition{}, s, 0.05);
+  EXPECT_NE(t.note.find("smallest 0.45 at Ca=0.4"), std::string::npos) << t.note;
+  EXPECT_EQ(t.note.find("0.4497"), std::string::npos) << t.note;
+}
+
 TEST(Transitions, CaHIsInterpolatedBetweenTheBracketingSamples) {
   auto s = samples({0.2, 0.4, 0.6, 1.0, 1.5}, d12_oblate, tau_oblate);
   Transition t = analyse_group(Transition{}, s, 0.05);

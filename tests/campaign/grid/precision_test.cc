@@ -2,7 +2,7 @@
 // interpolated values to the leading digit of their error, diagnostics to 3 significant digits.
 #include <gtest/gtest.h>
 
-#include "campaign/query/precision.h"
+#include "campaign/grid/precision.h"
 
 namespace capsim::campaign {
 namespace {

@@ -1,4 +1,4 @@
-#include "campaign/query/precision.h"
+#include "campaign/grid/precision.h"
 
 #include <cmath>
 #include <cstdio>

@@ -205,11 +205,13 @@ TEST(CaseDriver, SnapshotsDoNotChangeTheRun) {
 TEST(CaseDriver, RefusedRkcStepIsAnUnstableOutcome) {
   config::CaseConfig c;
   c.aspect_ratio = 2.0;
-  c.capillary_number = 0.05;
+  c.capillary_number = 1e-4;
   c.level = 1;
   c.scheme = "rkc";
-  c.dt = 500.0;  // dt ρ ≈ 3e5 at level 1 and Ca 0.05: about 700 stages, beyond the 400 allowed
-  c.t_end = 1000.0;
+  // ρ ∝ 1/(Ca h_min) ≈ 4e5 at level 1 and Ca 1e-4, so the largest accepted dt (1) needs ≈ 900 stages, beyond
+  // the 400 allowed (stages_for: β(s) ≈ 0.653 s² ≥ 1.25 dt ρ).
+  c.dt = 1.0;
+  c.t_end = 10.0;
   const auto dir = scratch("rkc_refused");
   CaseResult r;
   ASSERT_NO_THROW(r = run_case(c, quiet_in(dir)));

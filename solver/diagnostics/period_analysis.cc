@@ -31,6 +31,16 @@ double wrap_axis_angle(double a) {
   return w;
 }
 
+// Trapezoidal time mean of y over the samples [i0, i1] (y[i0] when they span no time).
+double time_mean(std::span<const double> t, std::span<const double> y, std::size_t i0, std::size_t i1) {
+  double span = 0, sum = 0;
+  for (std::size_t i = i0; i < i1; ++i) {
+    span += t[i + 1] - t[i];
+    sum += 0.5 * (t[i + 1] - t[i]) * (y[i] + y[i + 1]);
+  }
+  return span > 0 ? sum / span : y[i0];
+}
+
 // Statistics of the samples [i0, i1] (time bounds tb, te already set in w).
 void fill_window(PeriodWindow& w, std::span<const double> t, std::span<const double> D12,
                  std::span<const double> theta_u, std::span<const double> tau_min) {
@@ -217,7 +227,14 @@ PeriodAnalysis analyse_periods(std::span<const double> t, std::span<const double
   // 2 D12 Δθ ≤ tol is written without dividing so that a circular section (D12 = 0) passes.
   if (tail && options.stationary_tolerance > 0) {
     const double tol = options.stationary_tolerance;
-    if (tail->d_hi - tail->d_lo <= tol && 2.0 * std::abs(tail->d_hi) * tail->th_spread <= tol) return steady(*tail);
+    const double shape = 2.0 * std::abs(tail->d_hi);  // boundary displacement per radian of θ
+    const std::size_t mid = (tail->i0 + n - 1) / 2;
+    const double drift_D12 = time_mean(t, D12, mid, n - 1) - time_mean(t, D12, tail->i0, mid);
+    const double drift_theta = time_mean(t, theta_u, mid, n - 1) - time_mean(t, theta_u, tail->i0, mid);
+    const double bound = options.stationary_fluctuation * tol;
+    if (std::abs(drift_D12) <= tol && shape * std::abs(drift_theta) <= tol && tail->d_hi - tail->d_lo <= bound &&
+        shape * tail->th_spread <= bound)
+      return steady(*tail);
   }
 
   // 2. Significant minima of D12, with a prominence scaled on the recent oscillation.

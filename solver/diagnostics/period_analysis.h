@@ -61,20 +61,23 @@ struct PeriodOptions {
   ///    period-to-period comparison to confirm that the run has converged, so stopping a run early needs a
   ///    shape settled well below the period tolerance.
   /// 2. Stationary (tried next, before the periodic rules, and only where `stationary_tolerance` > 0 — the
-  ///    driver sets it for the final analysis of a run, to time.period_tolerance): the spread of D12 is
-  ///    ≤ stationary_tolerance, and so is the shape change 2·D12·Δθ that the spread Δθ of θ makes. This
-  ///    classifies what a run ended with (e.g. a sphere whose D12 flickers by 10⁻³ with the wrinkles, run to
-  ///    its t_end) instead of leaving it `unknown` or taking the flicker's own D12 minima for a swinging;
-  ///    the reported spreads say how steady it was. A real swinging or tumbling shape changes D12 by far more
-  ///    than the tolerance within any window of 5 time units, so it is never taken for steady.
+  ///    driver sets it for the final analysis of a run, to time.period_tolerance): the time means of D12 over
+  ///    the two halves of the window differ by ≤ stationary_tolerance (no drift), and so does the shape
+  ///    change 2·D12·Δθ of the means of θ; the spread of D12 (and 2·D12 × the spread of θ) stays below
+  ///    stationary_fluctuation × stationary_tolerance (flicker, not an oscillation of the shape). This
+  ///    classifies what a run ended with (e.g. a sphere whose D12 flickers by a few 10⁻³ with the wrinkles,
+  ///    run to its t_end) instead of leaving it `unknown` or taking the flicker's own D12 minima for a
+  ///    swinging; the reported spreads say how steady it was.
   ///
   /// Why the stationary test. Its tolerance is the one the stop test puts on min D12 between successive
-  /// periods: a steady state is a periodic one whose period has shrunk to nothing, held to the same accuracy.
-  /// The spread bounds the drift too (a trend of slope s moves D12 by s·window across the window), so a
-  /// transient still relaxing by more than the tolerance per window is rejected. The θ bound converts a
-  /// rotation into the boundary displacement it causes on an ellipse of Taylor parameter D (≈ 2 D δθ,
-  /// against δD for a change of D12), so D12 and θ are held to the same shape accuracy; as D12 → 0 (a
-  /// circular section, whose θ is noise) it relaxes by itself. The window: the shape relaxes on the membrane
+  /// periods: a steady state is a periodic one whose period has shrunk to nothing, held to the same accuracy,
+  /// and the difference of the half-window means is what a drift (a transient still relaxing) changes, while
+  /// zero-mean flicker does not. The fluctuation bound keeps real oscillations out: mesh-scale flicker of D12
+  /// is a few 10⁻³ at level 3 (results/steady_spheres), while a swinging or tumbling shape moves D12 by
+  /// O(10⁻²) and more within any 5 time units (results/table1.sqlite). The θ terms convert a rotation into
+  /// the boundary displacement it causes on an ellipse of Taylor parameter D (≈ 2 D δθ, against δD for a
+  /// change of D12), so D12 and θ are held to the same shape accuracy; as D12 → 0 (a circular section, whose
+  /// θ is noise) they relax by themselves. The window: the shape relaxes on the membrane
   /// time scale, O(1) in units of 1/γ̇ for the Ca of interest (0.1–1), and wrinkles flicker on much shorter
   /// scales, so 5 units covers several relaxation times (a transient with time constant τ ≲ 1 has decayed
   /// by e⁻⁵ across it if its spread passes) and many flicker cycles (so max/min/mean of τmin over it are
@@ -82,7 +85,8 @@ struct PeriodOptions {
   double steady_window = 5.0;
   double settled_tol_D12 = 1e-4;
   double settled_tol_theta = 1e-3;
-  double stationary_tolerance = 0.0;  ///< 0: rule 4 off (as during the march)
+  double stationary_tolerance = 0.0;  ///< 0: the stationary rule is off (as during the march)
+  double stationary_fluctuation = 5.0;
   /// At most this many most-recent periods are analysed.
   int max_periods = 16;
 };

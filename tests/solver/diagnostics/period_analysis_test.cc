@@ -240,6 +240,32 @@ TEST(PeriodAnalysis, StationaryShapeWithFlickeringTauMinIsSteady) {
   EXPECT_NE(analyse(s, tight).regime, Regime::steady);
 }
 
+// A sphere at small Ca wrinkles more: D12 flickers with a spread (≈ 4e-3) above the tolerance while its
+// mean does not move. Stationary (no drift between the half-window means) is what counts, not the spread;
+// an oscillation of the shape by 2e-2 (a swinging's order) is refused even without drift.
+TEST(PeriodAnalysis, FlickerAboveTheToleranceWithoutDriftIsSteady) {
+  auto flicker = [](double t) { return std::sin(41.3 * t) * std::cos(17.1 * t + 0.4) + 0.5 * std::sin(97.0 * t); };
+  auto f = [&](double t, double& d, double& th, double& tau) {
+    d = 0.27 + 1.3e-3 * flicker(t);
+    th = 0.53 + 1e-3 * flicker(1.3 * t);
+    tau = -0.15 + 0.02 * flicker(2.1 * t);
+  };
+  const Signal s = sample(10.0, 0.01, f);
+  double lo = INFINITY, hi = -INFINITY;
+  for (std::size_t i = 0; i < s.t.size(); ++i)
+    if (s.t[i] >= s.t.back() - PeriodOptions{}.steady_window) lo = std::min(lo, s.D12[i]), hi = std::max(hi, s.D12[i]);
+  ASSERT_GT(hi - lo, 2e-3) << "the flicker must exceed the tolerance for this test to mean something";
+  const auto a = analyse(s, final_analysis());
+  EXPECT_EQ(a.regime, Regime::steady);
+  EXPECT_NEAR(a.mean_D12, 0.27, 2e-4);
+  auto g = [&](double t, double& d, double& th, double& tau) {
+    d = 0.27 + 1e-2 * std::sin(2 * kPi * t / 2.5);  // D12 oscillating by 2e-2, period 2.5: no drift
+    th = 0.53;
+    tau = -0.15;
+  };
+  EXPECT_NE(analyse(sample(10.0, 0.01, g), final_analysis()).regime, Regime::steady);
+}
+
 TEST(PeriodAnalysis, SlowlyDriftingShapeIsNotSteady) {
   // D12 creeping up by 1e-3 per time unit (5e-3 over the window), θ fixed: not stationary.
   auto f = [](double t, double& d, double& th, double& tau) {

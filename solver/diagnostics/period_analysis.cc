@@ -53,19 +53,11 @@ void fill_window(PeriodWindow& w, std::span<const double> t, std::span<const dou
   const auto [th_lo, th_hi] = std::minmax_element(theta_u.begin() + i0, theta_u.begin() + i1 + 1);
   w.theta_amplitude = 0.5 * (*th_hi - *th_lo);
   w.theta_sweep = theta_u[i1] - theta_u[i0];
-  double span = 0, sD = 0, sT = 0, sTau = 0;
-  for (std::size_t i = i0; i < i1; ++i) {
-    const double h = t[i + 1] - t[i];
-    span += h;
-    sD += 0.5 * h * (D12[i] + D12[i + 1]);
-    sT += 0.5 * h * (theta_u[i] + theta_u[i + 1]);
-    sTau += 0.5 * h * (tau_min[i] + tau_min[i + 1]);
-  }
-  w.mean_D12 = span > 0 ? sD / span : D12[i0];
+  w.mean_D12 = time_mean(t, D12, i0, i1);
   // Unwrapped θ carries the multiples of π picked up on the way (e.g. from the noisy θ of a sphere at
   // rest); the mean axis is reported in (−π/2, π/2] like θ itself.
-  w.theta_mean = wrap_axis_angle(span > 0 ? sT / span : theta_u[i0]);
-  w.mean_tau_min = span > 0 ? sTau / span : tau_min[i0];
+  w.theta_mean = wrap_axis_angle(time_mean(t, theta_u, i0, i1));
+  w.mean_tau_min = time_mean(t, tau_min, i0, i1);
 }
 
 // Periods of a tumbling axis: back from the last sample, each window ends where the previous one began and

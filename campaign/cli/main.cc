@@ -24,6 +24,7 @@ void print_usage() {
       "  capsim campaign status --db FILE\n"
       "  capsim query table1|cases|sql ... --db FILE [--format md|csv|json]\n"
       "  capsim bench kernel [--json]\n"
+      "  capsim bench flow [--level L] [--threads T] [--json]\n"
       "  capsim keys --format md\n"
       "  capsim --version\n",
       capsim::kVersion, capsim::kGitCommit);

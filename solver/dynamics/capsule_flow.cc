@@ -57,7 +57,14 @@ FlowEvaluation CapsuleFlow::velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd
   auto t0 = std::chrono::steady_clock::now();
   single_layer_->apply(x, q_, u_);
   timings_.stokes_s += seconds_since(t0);
-  out.used_symmetry = single_layer_->last_stats().used_symmetry;
+  const stokes::SingleLayerStats& st = single_layer_->last_stats();
+  out.used_symmetry = st.used_symmetry;
+  timings_.layout_s += st.build_s;
+  timings_.regular_s += st.regular_s;
+  timings_.far_s += st.far_s;
+  timings_.singular_s += st.singular_s;
+  timings_.near_s += st.near_s;
+  t0 = std::chrono::steady_clock::now();
 
   // v = v∞ − u/(8π Ca): the membrane pushes the fluid with −q (solver/README.md §3).
   const double factor = -1.0 / (8.0 * std::numbers::pi * Ca_);
@@ -78,6 +85,7 @@ FlowEvaluation CapsuleFlow::velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd
   }
   out.volume_flux = flux_v;
   if (volume_correction_) v -= (flux_v / flux_n) * normals_;
+  timings_.volume_s += seconds_since(t0);
   if (load) *load = q_;
   ++timings_.evaluations;
   return out;

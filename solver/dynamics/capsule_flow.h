@@ -37,10 +37,17 @@ struct FlowEvaluation {
 };
 
 /// @brief Accumulated wall time of the phases of flow evaluations (exafmm-style named phases).
+/// The boundary integral's total (stokes_s) is split into the SingleLayer phases (SingleLayerStats).
 struct FlowTimings {
   double membrane_s = 0.0;   ///< kinematics, energy gradient
   double load_s = 0.0;       ///< mass matrix assembly + factorisation + solve
-  double stokes_s = 0.0;     ///< boundary integral
+  double stokes_s = 0.0;     ///< boundary integral: the sum of the five phases below
+  double layout_s = 0.0;     ///< symmetry check, quadrature points laid out as SoA
+  double regular_s = 0.0;    ///< regular Stokeslet sum over all quadrature points
+  double far_s = 0.0;        ///< far-field tier (0 when off)
+  double singular_s = 0.0;   ///< Duffy correction of the elements containing each node
+  double near_s = 0.0;       ///< near-singular correction of their neighbours, mirror
+  double volume_s = 0.0;     ///< v = v∞ − u/(8πCa), node normals, flux and volume correction
   long evaluations = 0;
 };
 
@@ -68,6 +75,8 @@ class CapsuleFlow {
   [[nodiscard]] const membrane::MembraneMechanics& mechanics() const { return *mechanics_; }
   [[nodiscard]] double capillary_number() const { return Ca_; }
   [[nodiscard]] const FlowTimings& timings() const { return timings_; }
+  /// @brief The boundary-integral operator (benchmarks compare its phases with the bare kernel).
+  [[nodiscard]] stokes::SingleLayer& single_layer() { return *single_layer_; }
   /// @brief Switch the undisturbed shear flow v∞ off (fluid at rest: relaxation tests) or on (default).
   void set_background_flow(bool on) { background_flow_ = on; }
 

@@ -22,4 +22,19 @@ inline std::array<std::array<double, 6>, 2> p2_shape_gradients(double xi, double
            {1.0 - 4.0 * l0, 0.0, 4.0 * eta - 1.0, -4.0 * xi, 4.0 * xi, 4.0 * (l0 - eta)}}};
 }
 
+/// @brief Monomial coefficients of a P2 interpolant of nodal values f_a (one component):
+///     f(ξ, η) = c0 + c1 ξ + c2 η + c3 ξ² + c4 ξη + c5 η²,
+/// so that f = c0 + ξ (c1 + c3 ξ + c4 η) + η (c2 + c5 η), ∂f/∂ξ = c1 + 2 c3 ξ + c4 η and
+/// ∂f/∂η = c2 + c4 ξ + 2 c5 η: position and both tangents at a point for 8 multiply-adds per component
+/// instead of 18 for the three sums Σ_a over the nodal shape functions (the hot loops of the boundary
+/// integral use it; the two forms agree to rounding).
+inline void p2_monomials(const double f[6], double c[6]) {
+  c[0] = f[0];
+  c[1] = -3.0 * f[0] - f[1] + 4.0 * f[3];
+  c[2] = -3.0 * f[0] - f[2] + 4.0 * f[5];
+  c[3] = 2.0 * f[0] + 2.0 * f[1] - 4.0 * f[3];
+  c[4] = 4.0 * (f[0] + f[4] - f[3] - f[5]);
+  c[5] = 2.0 * f[0] + 2.0 * f[2] - 4.0 * f[5];
+}
+
 }  // namespace capsim::mesh

@@ -26,6 +26,7 @@ namespace capsim::mesh {
 /// @brief One point on the reference triangle: weight, shape values N_a and derivatives ∂N_a/∂ξ, ∂N_a/∂η.
 struct P2Point {
   double w = 0.0;  ///< weight in dξ dη (½ w_i for a triangle rule; a sub-triangle or Duffy Jacobian included)
+  double xi = 0.0, eta = 0.0;  ///< the point on the reference triangle
   double n[6] = {}, dxi[6] = {}, deta[6] = {};
 };
 
@@ -33,6 +34,8 @@ struct P2Point {
 inline P2Point p2_point(double xi, double eta, double w) {
   P2Point p;
   p.w = w;
+  p.xi = xi;
+  p.eta = eta;
   const auto n = p2_shape(xi, eta);
   const auto g = p2_shape_gradients(xi, eta);
   for (int a = 0; a < 6; ++a) {

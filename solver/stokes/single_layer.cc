@@ -52,7 +52,13 @@ SingleLayer::SingleLayer(const mesh::SurfaceMesh& mesh, const SingleLayerOptions
   for (int l = 0; l < 6; ++l) duffy_[l] = make_point_table(duffy_rule(l, opt_.duffy_order));
   if (opt_.near_subdivision > 0) {
     near_rule_ = replace_rule(subdivided_rule(opt_.near_subdivision, opt_.near_degree), regular_);
+    // Padded with zero-weight points (zero load, at the centroid) to whole SIMD vectors: kernel::sum_blocks.
+    const int w = kernel::simd_width();
+    while (near_rule_.size() % static_cast<std::size_t>(w) != 0) near_rule_.push_back(mesh::p2_point(1.0 / 3, 1.0 / 3, 0.0));
     near_ = near_singular_elements(mesh);
+    near_begin_.resize(near_.elements.size());
+    for (std::size_t k = 0; k < near_.elements.size(); ++k)
+      near_begin_[k] = near_.elements[k] * static_cast<int>(near_rule_.size());
   }
   if (opt_.far_degree > 0) {
     const auto coarse = mesh::P2Tabulation::of_degree(opt_.far_degree);
@@ -154,10 +160,8 @@ long long SingleLayer::far_field(const Eigen::Matrix3Xd& x, const Eigen::Matrix3
                         target_ids_, x, mid_scratch_, u);
 }
 
-void SingleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q,
-                                      Eigen::Matrix3Xd& u) const {
+void SingleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) {
   const int nt = static_cast<int>(target_ids_.size()), nq = rule_size_;
-  const int nr = static_cast<int>(near_rule_.size());
   const SourceArrays& reg = *regular_points_;
   const int stride = regular_stride_;
   const int* slot = regular_slot_;
@@ -173,34 +177,34 @@ void SingleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Ma
       const int b = (slot != nullptr ? slot[e] : e) * stride;
       add_block(x0, reg, b, b + nq, -1.0, acc);
       // ... and add the Duffy integral with the node at the apex. Positions relative to x0 (Σ N_a = 1)
-      // avoid cancellation near the apex.
-      double R[6][3], Q[6][3];
-      for (int a = 0; a < 6; ++a)
-        for (int c = 0; c < 3; ++c) {
-          R[a][c] = x(c, el[a]) - x0[c];
-          Q[a][c] = q(c, el[a]);
+      // avoid cancellation near the apex; geometry and load in monomial form (mesh::p2_monomials).
+      double C[6][3], D[6][3];
+      for (int c = 0; c < 3; ++c) {
+        double r[6], f[6], cr[6], cf[6];
+        for (int a = 0; a < 6; ++a) {
+          r[a] = x(c, el[a]) - x0[c];
+          f[a] = q(c, el[a]);
         }
+        mesh::p2_monomials(r, cr);
+        mesh::p2_monomials(f, cf);
+        for (int m = 0; m < 6; ++m) {
+          C[m][c] = cr[m];
+          D[m][c] = cf[m];
+        }
+      }
       const PointTable& tb = duffy_[l];
-      const double *n0 = tb.n[0].data(), *n1 = tb.n[1].data(), *n2 = tb.n[2].data(), *n3 = tb.n[3].data(),
-                   *n4 = tb.n[4].data(), *n5 = tb.n[5].data();
-      const double *a0 = tb.dxi[0].data(), *a1 = tb.dxi[1].data(), *a2 = tb.dxi[2].data(), *a3 = tb.dxi[3].data(),
-                   *a4 = tb.dxi[4].data(), *a5 = tb.dxi[5].data();
-      const double *b0 = tb.deta[0].data(), *b1 = tb.deta[1].data(), *b2 = tb.deta[2].data(),
-                   *b3 = tb.deta[3].data(), *b4 = tb.deta[4].data(), *b5 = tb.deta[5].data();
-      const double* wt = tb.w.data();
+      const double *pxi = tb.xi.data(), *peta = tb.eta.data(), *wt = tb.w.data();
       double sx = 0.0, sy = 0.0, sz = 0.0;
 #pragma omp simd reduction(+ : sx, sy, sz)
       for (int p = 0; p < tb.count; ++p) {
+        const double xi = pxi[p], eta = peta[p];
         double d[3], t1[3], t2[3], qq[3];
         for (int c = 0; c < 3; ++c) {
-          d[c] = n0[p] * R[0][c] + n1[p] * R[1][c] + n2[p] * R[2][c] + n3[p] * R[3][c] + n4[p] * R[4][c] +
-                 n5[p] * R[5][c];
-          t1[c] = a0[p] * R[0][c] + a1[p] * R[1][c] + a2[p] * R[2][c] + a3[p] * R[3][c] + a4[p] * R[4][c] +
-                  a5[p] * R[5][c];
-          t2[c] = b0[p] * R[0][c] + b1[p] * R[1][c] + b2[p] * R[2][c] + b3[p] * R[3][c] + b4[p] * R[4][c] +
-                  b5[p] * R[5][c];
-          qq[c] = n0[p] * Q[0][c] + n1[p] * Q[1][c] + n2[p] * Q[2][c] + n3[p] * Q[3][c] + n4[p] * Q[4][c] +
-                  n5[p] * Q[5][c];
+          const double a = C[1][c] + xi * C[3][c] + eta * C[4][c], b = C[2][c] + eta * C[5][c];
+          d[c] = C[0][c] + xi * a + eta * b;
+          t1[c] = a + xi * C[3][c];
+          t2[c] = b + xi * C[4][c] + eta * C[5][c];
+          qq[c] = D[0][c] + xi * (D[1][c] + xi * D[3][c] + eta * D[4][c]) + eta * (D[2][c] + eta * D[5][c]);
         }
         const double nx = t1[1] * t2[2] - t1[2] * t2[1], ny = t1[2] * t2[0] - t1[0] * t2[2],
                      nz = t1[0] * t2[1] - t1[1] * t2[0];
@@ -215,13 +219,25 @@ void SingleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Ma
       acc[1] += sy;
       acc[2] += sz;
     }
+    ux_[it] = acc[0];
+    uy_[it] = acc[1];
+    uz_[it] = acc[2];
+  }
+}
+
+void SingleLayer::near_correction(Eigen::Matrix3Xd& u) {
+  const int nt = static_cast<int>(target_ids_.size());
+  const int nr = static_cast<int>(near_rule_.size());
+  const kernel::Sources np = near_points_.sources();
+#pragma omp parallel for schedule(dynamic, 16)
+  for (int it = 0; it < nt; ++it) {
+    const int i = target_ids_[it];
+    const double x0[3] = {tx_[it], ty_[it], tz_[it]};
+    double acc[3] = {ux_[it], uy_[it], uz_[it]};
     // Near-singular neighbours: subdivided rule in, regular rule out (negative weights), one block each.
-    if (nr > 0) {
-      for (int k = near_.offsets[i]; k < near_.offsets[i + 1]; ++k) {
-        const int e = near_.elements[k];
-        add_block(x0, near_points_, e * nr, (e + 1) * nr, 1.0, acc);
-      }
-    }
+    if (nr > 0)
+      kernel::sum_blocks(x0, np, near_begin_.data() + near_.offsets[i], near_.offsets[i + 1] - near_.offsets[i], nr,
+                         acc);
     u(0, i) += acc[0];
     u(1, i) += acc[1];
     u(2, i) += acc[2];
@@ -252,6 +268,7 @@ void SingleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Ei
   // 1. Layout: with the far-field tier the all-pairs sum runs over the coarse rule, else the regular rule.
   const bool far = opt_.far_degree > 0;
   layout_points(far ? coarse_ : regular_, elements_, x, q, kernel::simd_width(), sources_);
+  if (!near_rule_.empty()) layout_points(near_rule_, elements_, x, q, 1, near_points_);
   regular_points_ = &sources_;
   regular_stride_ = rule_size_;
   regular_slot_ = nullptr;
@@ -264,11 +281,12 @@ void SingleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Ei
   const long long mids = far ? far_field(x, q, u) : 0;
   const double t2f = now_s();
   // 4. Singular and near-singular corrections.
-  if (!near_rule_.empty()) layout_points(near_rule_, elements_, x, q, 1, near_points_);
-  singular_correction(x, q, u);
+  singular_correction(x, q);
+  const double t3 = now_s();
+  near_correction(u);
   // 5. Mirror.
   if (sym) mirror(u);
-  const double t3 = now_s();
+  const double t4 = now_s();
 
   stats_.used_symmetry = sym;
   stats_.targets = static_cast<int>(target_ids_.size());
@@ -277,8 +295,9 @@ void SingleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Ei
   stats_.build_s = t1 - t0;
   stats_.regular_s = t2 - t1;
   stats_.far_s = far ? t2f - t2 : 0.0;
-  stats_.singular_s = far ? t3 - t2f : t3 - t2;
-  stats_.total_s = t3 - t0;
+  stats_.singular_s = t3 - t2f;
+  stats_.near_s = t4 - t3;
+  stats_.total_s = t4 - t0;
 }
 
 Eigen::Matrix3Xd SingleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) {

@@ -103,9 +103,10 @@ struct SingleLayerStats {
   bool used_symmetry = false;  ///< whether only half of the targets were evaluated
   int targets = 0;             ///< number of targets evaluated
   int sources = 0;             ///< quadrature points of the all-pairs sum (unpadded; coarse rule if far on)
-  double build_s = 0.0;        ///< laying out the quadrature points (SoA)
-  double regular_s = 0.0;      ///< regular Stokeslet sum
-  double singular_s = 0.0;     ///< singular and near-singular corrections (including their point layout)
+  double build_s = 0.0;        ///< symmetry check and laying out the regular and near-rule points (SoA)
+  double regular_s = 0.0;      ///< regular Stokeslet sum (target selection and scatter included)
+  double singular_s = 0.0;     ///< singular (Duffy) correction of the elements containing each target
+  double near_s = 0.0;         ///< near-singular correction of their neighbours (and the mirror)
   double far_s = 0.0;          ///< far-field tier: centroid grid and "regular − coarse" blocks (0 when off)
   long long mid_elements = 0;  ///< Σ over targets of the elements given the regular rule (0 when off)
   double total_s = 0.0;
@@ -126,6 +127,8 @@ class SingleLayer {
   [[nodiscard]] bool is_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) const;
 
   [[nodiscard]] const SingleLayerStats& last_stats() const { return stats_; }
+  /// @brief The nodes the last apply() evaluated (all, or one of each mirror pair), in evaluation order.
+  [[nodiscard]] const std::vector<int>& last_targets() const { return target_ids_; }
   [[nodiscard]] const SingleLayerOptions& options() const { return opt_; }
   [[nodiscard]] int num_nodes() const { return num_nodes_; }
   [[nodiscard]] int num_elements() const { return static_cast<int>(elements_.size()); }
@@ -143,7 +146,10 @@ class SingleLayer {
   void select_targets(const Eigen::Matrix3Xd& x, bool symmetric);
   void regular_sum(const kernel::Sources& src, Eigen::Matrix3Xd& u);
   long long far_field(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Eigen::Matrix3Xd& u);
-  void singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Eigen::Matrix3Xd& u) const;
+  // The two corrections accumulate per target into ux_, uy_, uz_ (free after regular_sum), and the near
+  // phase adds the total to u: the same additions in the same order as one fused loop.
+  void singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q);
+  void near_correction(Eigen::Matrix3Xd& u);
   void mirror(Eigen::Matrix3Xd& u) const;
 
   SingleLayerOptions opt_;
@@ -157,6 +163,7 @@ class SingleLayer {
   PointTable duffy_[6];                     // Duffy rule per local node position (SoA)
   std::vector<mesh::P2Point> near_rule_;    // subdivided rule, then the regular rule negated (empty if off)
   NearSingularElements near_;               // node → near-singular elements (empty if off)
+  std::vector<int> near_begin_;             // first near point of each entry of near_.elements
   std::vector<mesh::P2Point> coarse_;       // far-field rule (empty if off)
   std::vector<mesh::P2Point> mid_rule_;     // regular rule, then the coarse rule negated (empty if off)
   // Work arrays of apply().

@@ -52,13 +52,11 @@ std::vector<mesh::P2Point> duffy_rule(int local, int order) {
 PointTable make_point_table(const std::vector<mesh::P2Point>& rule) {
   PointTable t;
   t.count = static_cast<int>(rule.size());
-  for (int a = 0; a < 6; ++a)
-    for (const mesh::P2Point& p : rule) {
-      t.n[a].push_back(p.n[a]);
-      t.dxi[a].push_back(p.dxi[a]);
-      t.deta[a].push_back(p.deta[a]);
-    }
-  for (const mesh::P2Point& p : rule) t.w.push_back(p.w);
+  for (const mesh::P2Point& p : rule) {
+    t.xi.push_back(p.xi);
+    t.eta.push_back(p.eta);
+    t.w.push_back(p.w);
+  }
   return t;
 }
 

@@ -22,10 +22,10 @@ namespace capsim::stokes {
 /// direction of each collapsed square. Weights in dξ dη (Duffy Jacobian included).
 std::vector<mesh::P2Point> duffy_rule(int local, int order);
 
-/// @brief A rule as structure of arrays: n[a], dxi[a], deta[a] (a = 0..5) and w, each of length count.
+/// @brief A rule as structure of arrays: the points (ξ, η) and weights w, each of length count.
 struct PointTable {
   int count = 0;
-  AlignedVector n[6], dxi[6], deta[6], w;
+  AlignedVector xi, eta, w;
 };
 
 /// @brief The SoA table of a rule.

@@ -1,5 +1,10 @@
 #include "solver/stokes/source_layout.h"
 
+#include <cmath>
+#include <vector>
+
+#include "solver/mesh/p2_element.h"
+
 namespace capsim::stokes {
 
 void layout_points(const std::vector<mesh::P2Point>& rule, const std::vector<std::array<int, 6>>& elements,
@@ -10,35 +15,52 @@ void layout_points(const std::vector<mesh::P2Point>& rule, const std::vector<std
   for (auto* v : {&out.x, &out.y, &out.z, &out.qx, &out.qy, &out.qz}) v->assign(static_cast<std::size_t>(npad), 0.0);
   double *px = out.x.data(), *py = out.y.data(), *pz = out.z.data(), *pqx = out.qx.data(), *pqy = out.qy.data(),
          *pqz = out.qz.data();
+  // The rule as arrays (ξ, η, w), the element's geometry and load in monomial form (mesh::p2_monomials).
+  std::vector<double> rxi(static_cast<std::size_t>(nq)), reta(rxi.size()), rw(rxi.size());
+  for (int k = 0; k < nq; ++k) {
+    rxi[k] = rule[k].xi;
+    reta[k] = rule[k].eta;
+    rw[k] = rule[k].w;
+  }
+  const double *pxi = rxi.data(), *peta = reta.data(), *pw = rw.data();
 #pragma omp parallel for schedule(static)
   for (int e = 0; e < ne; ++e) {
     const auto& el = elements[e];
-    double X[6][3], Q[6][3];
-    for (int a = 0; a < 6; ++a)
-      for (int c = 0; c < 3; ++c) {
-        X[a][c] = x(c, el[a]);
-        Q[a][c] = q(c, el[a]);
+    double C[6][3], D[6][3];
+    for (int c = 0; c < 3; ++c) {
+      double f[6], g[6], cf[6], cg[6];
+      for (int a = 0; a < 6; ++a) {
+        f[a] = x(c, el[a]);
+        g[a] = q(c, el[a]);
       }
+      mesh::p2_monomials(f, cf);
+      mesh::p2_monomials(g, cg);
+      for (int m = 0; m < 6; ++m) {
+        C[m][c] = cf[m];
+        D[m][c] = cg[m];
+      }
+    }
+    const int j0 = e * nq;
+#pragma omp simd
     for (int k = 0; k < nq; ++k) {
-      const mesh::P2Point& s = rule[k];
-      double p[3] = {0, 0, 0}, t1[3] = {0, 0, 0}, t2[3] = {0, 0, 0}, qq[3] = {0, 0, 0};
-      for (int a = 0; a < 6; ++a)
-        for (int c = 0; c < 3; ++c) {
-          p[c] += s.n[a] * X[a][c];
-          t1[c] += s.dxi[a] * X[a][c];
-          t2[c] += s.deta[a] * X[a][c];
-          qq[c] += s.n[a] * Q[a][c];
-        }
+      const double xi = pxi[k], eta = peta[k];
+      double p[3], t1[3], t2[3], qq[3];
+      for (int c = 0; c < 3; ++c) {
+        const double a = C[1][c] + xi * C[3][c] + eta * C[4][c], b = C[2][c] + eta * C[5][c];
+        p[c] = C[0][c] + xi * a + eta * b;
+        t1[c] = a + xi * C[3][c];
+        t2[c] = b + xi * C[4][c] + eta * C[5][c];
+        qq[c] = D[0][c] + xi * (D[1][c] + xi * D[3][c] + eta * D[4][c]) + eta * (D[2][c] + eta * D[5][c]);
+      }
       const double nx = t1[1] * t2[2] - t1[2] * t2[1], ny = t1[2] * t2[0] - t1[0] * t2[2],
                    nz = t1[0] * t2[1] - t1[1] * t2[0];
-      const double wj = s.w * std::sqrt(nx * nx + ny * ny + nz * nz);
-      const int j = e * nq + k;
-      px[j] = p[0];
-      py[j] = p[1];
-      pz[j] = p[2];
-      pqx[j] = wj * qq[0];
-      pqy[j] = wj * qq[1];
-      pqz[j] = wj * qq[2];
+      const double wj = pw[k] * std::sqrt(nx * nx + ny * ny + nz * nz);
+      px[j0 + k] = p[0];
+      py[j0 + k] = p[1];
+      pz[j0 + k] = p[2];
+      pqx[j0 + k] = wj * qq[0];
+      pqy[j0 + k] = wj * qq[1];
+      pqz[j0 + k] = wj * qq[2];
     }
   }
 }

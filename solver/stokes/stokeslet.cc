@@ -75,6 +75,36 @@ inline void tile(const double* tx, const double* ty, const double* tz, const Sou
   }
 }
 
+// One target (broadcast) against blocks of sources in lanes; Newton 1/r as in tile<·, 1>.
+inline void blocks(const double x0[3], const Sources& s, const int* begins, int count, int length, double u[3]) {
+  const __m512d X = _mm512_set1_pd(x0[0]), Y = _mm512_set1_pd(x0[1]), Z = _mm512_set1_pd(x0[2]);
+  const __m512d zero = _mm512_setzero_pd(), one = _mm512_set1_pd(1.0);
+  const __m512d c1 = _mm512_set1_pd(kC1), c2 = _mm512_set1_pd(kC2), c3 = _mm512_set1_pd(kC3);
+  __m512d UX = zero, UY = zero, UZ = zero;
+  for (int k = 0; k < count; ++k) {
+    const int b = begins[k];
+    for (int p = b; p < b + length; p += kLanes) {
+      const __m512d dx = _mm512_sub_pd(X, _mm512_loadu_pd(s.x + p));
+      const __m512d dy = _mm512_sub_pd(Y, _mm512_loadu_pd(s.y + p));
+      const __m512d dz = _mm512_sub_pd(Z, _mm512_loadu_pd(s.z + p));
+      const __m512d qx = _mm512_loadu_pd(s.qx + p), qy = _mm512_loadu_pd(s.qy + p), qz = _mm512_loadu_pd(s.qz + p);
+      const __m512d r2 = _mm512_fmadd_pd(dz, dz, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dx, dx)));
+      const __mmask8 m = _mm512_cmp_pd_mask(r2, zero, _CMP_NEQ_UQ);
+      __m512d y = _mm512_maskz_rsqrt14_pd(m, r2);
+      const __m512d e = _mm512_fnmadd_pd(_mm512_mul_pd(r2, y), y, one);
+      y = _mm512_fmadd_pd(_mm512_mul_pd(e, _mm512_fmadd_pd(_mm512_fmadd_pd(e, c3, c2), e, c1)), y, y);
+      const __m512d rq = _mm512_fmadd_pd(dz, qz, _mm512_fmadd_pd(dy, qy, _mm512_mul_pd(dx, qx)));
+      const __m512d s2 = _mm512_mul_pd(rq, _mm512_mul_pd(y, y));
+      UX = _mm512_fmadd_pd(y, _mm512_fmadd_pd(dx, s2, qx), UX);
+      UY = _mm512_fmadd_pd(y, _mm512_fmadd_pd(dy, s2, qy), UY);
+      UZ = _mm512_fmadd_pd(y, _mm512_fmadd_pd(dz, s2, qz), UZ);
+    }
+  }
+  u[0] += _mm512_reduce_add_pd(UX);
+  u[1] += _mm512_reduce_add_pd(UY);
+  u[2] += _mm512_reduce_add_pd(UZ);
+}
+
 #elif defined(__AVX2__) && defined(__FMA__)
 constexpr int kLanes = 4;
 constexpr const char* kIsa = "avx2";
@@ -132,6 +162,45 @@ inline void tile(const double* tx, const double* ty, const double* tz, const Sou
   }
 }
 
+inline double hsum(__m256d v) {
+  const __m128d lo = _mm256_castpd256_pd128(v), hi = _mm256_extractf128_pd(v, 1);
+  const __m128d s = _mm_add_pd(lo, hi);
+  return _mm_cvtsd_f64(_mm_add_sd(s, _mm_unpackhi_pd(s, s)));
+}
+
+// One target (broadcast) against blocks of sources in lanes; Newton 1/r as in tile<·, 1>.
+inline void blocks(const double x0[3], const Sources& s, const int* begins, int count, int length, double u[3]) {
+  const __m256d X = _mm256_set1_pd(x0[0]), Y = _mm256_set1_pd(x0[1]), Z = _mm256_set1_pd(x0[2]);
+  const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
+  const __m256d c1 = _mm256_set1_pd(kC1), c2 = _mm256_set1_pd(kC2), c3 = _mm256_set1_pd(kC3),
+                c4 = _mm256_set1_pd(kC4);
+  __m256d UX = zero, UY = zero, UZ = zero;
+  for (int k = 0; k < count; ++k) {
+    const int b = begins[k];
+    for (int p = b; p < b + length; p += kLanes) {
+      const __m256d dx = _mm256_sub_pd(X, _mm256_loadu_pd(s.x + p));
+      const __m256d dy = _mm256_sub_pd(Y, _mm256_loadu_pd(s.y + p));
+      const __m256d dz = _mm256_sub_pd(Z, _mm256_loadu_pd(s.z + p));
+      const __m256d qx = _mm256_loadu_pd(s.qx + p), qy = _mm256_loadu_pd(s.qy + p), qz = _mm256_loadu_pd(s.qz + p);
+      const __m256d r2 = _mm256_fmadd_pd(dz, dz, _mm256_fmadd_pd(dy, dy, _mm256_mul_pd(dx, dx)));
+      const __m256d keep = _mm256_cmp_pd(r2, zero, _CMP_NEQ_UQ);
+      __m256d y = _mm256_and_pd(_mm256_cvtps_pd(_mm_rsqrt_ps(_mm256_cvtpd_ps(r2))), keep);
+      const __m256d e = _mm256_fnmadd_pd(_mm256_mul_pd(r2, y), y, one);
+      __m256d pe = _mm256_fmadd_pd(_mm256_fmadd_pd(e, c4, c3), e, c2);
+      pe = _mm256_fmadd_pd(pe, e, c1);
+      y = _mm256_fmadd_pd(_mm256_mul_pd(e, pe), y, y);
+      const __m256d rq = _mm256_fmadd_pd(dz, qz, _mm256_fmadd_pd(dy, qy, _mm256_mul_pd(dx, qx)));
+      const __m256d s2 = _mm256_mul_pd(rq, _mm256_mul_pd(y, y));
+      UX = _mm256_fmadd_pd(y, _mm256_fmadd_pd(dx, s2, qx), UX);
+      UY = _mm256_fmadd_pd(y, _mm256_fmadd_pd(dy, s2, qy), UY);
+      UZ = _mm256_fmadd_pd(y, _mm256_fmadd_pd(dz, s2, qz), UZ);
+    }
+  }
+  u[0] += hsum(UX);
+  u[1] += hsum(UY);
+  u[2] += hsum(UZ);
+}
+
 #else
 constexpr int kLanes = 8;
 constexpr const char* kIsa = "portable";
@@ -156,6 +225,26 @@ inline void tile(const double* tx, const double* ty, const double* tz, const Sou
     ux[l] = ax[l];
     uy[l] = ay[l];
     uz[l] = az[l];
+  }
+}
+
+// Portable: lanes as an inner loop the compiler vectorises, accumulated over all blocks.
+inline void blocks(const double x0[3], const Sources& s, const int* begins, int count, int length, double u[3]) {
+  double ax[kLanes] = {}, ay[kLanes] = {}, az[kLanes] = {};
+  for (int k = 0; k < count; ++k)
+    for (int p = begins[k]; p < begins[k] + length; p += kLanes) {
+#pragma omp simd
+      for (int l = 0; l < kLanes; ++l) {
+        const double dx = x0[0] - s.x[p + l], dy = x0[1] - s.y[p + l], dz = x0[2] - s.z[p + l];
+        const double r2 = dx * dx + dy * dy + dz * dz;
+        const double y = r2 == 0.0 ? 0.0 : 1.0 / std::sqrt(r2);
+        add_stokeslet(dx, dy, dz, s.qx[p + l], s.qy[p + l], s.qz[p + l], y, 1.0, ax[l], ay[l], az[l]);
+      }
+    }
+  for (int l = 0; l < kLanes; ++l) {
+    u[0] += ax[l];
+    u[1] += ay[l];
+    u[2] += az[l];
   }
 }
 #endif
@@ -228,6 +317,10 @@ void sum_plain(const Targets& t, const Sources& s, const Result& u) {
     u.y[i] = ay;
     u.z[i] = az;
   }
+}
+
+void sum_blocks(const double x0[3], const Sources& s, const int* begins, int count, int length, double u[3]) {
+  blocks(x0, s, begins, count, length, u);
 }
 
 const char* kernel_isa() { return kIsa; }

@@ -102,6 +102,13 @@ void sum_fast(const Targets& t, const Sources& s, const Result& u, const FastCon
 /// @brief The reference `omp simd` loop (sources in lanes). u is overwritten.
 void sum_plain(const Targets& t, const Sources& s, const Result& u);
 
+/// @brief u += Σ_k Σ_{p ∈ [begins[k], begins[k] + length)} J(x0, x_p)·w_p: one target against `count` short
+/// blocks of sources (the near-singular correction: the subdivided rule of each neighbouring element). Same
+/// 1/r as sum_fast (hardware estimate + one Newton step), the lanes accumulated over all blocks and reduced
+/// once. Requires length and every begins[k] to be multiples of simd_width() (pad each block with zero-load
+/// sources); a source at the target contributes nothing. Serial: call it from the caller's parallel loop.
+void sum_blocks(const double x0[3], const Sources& s, const int* begins, int count, int length, double u[3]);
+
 /// @brief Instruction set of sum_fast in this build: "avx512", "avx2" or "portable".
 const char* kernel_isa();
 

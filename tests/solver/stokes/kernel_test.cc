@@ -151,6 +151,42 @@ TEST(StokesletKernel, ZeroDistanceIsMaskedAndNaNPropagates) {
   EXPECT_TRUE(std::isnan(ux));
 }
 
+// sum_blocks (the near-singular correction's kernel): one target against a chosen subset of equal blocks of
+// sources equals the long-double sum over exactly those sources; a source at the target is masked; it adds
+// to what u held; a NaN propagates.
+TEST(StokesletKernel, BlocksSumExactlyTheListedBlocks) {
+  const int w = simd_width(), len = 3 * w, nblocks = 7;
+  Cloud c = random_cloud(1, len * nblocks, 11);
+  c.tx[0] = c.sx[len + 2];  // the target sits on a source of block 1 (listed)
+  c.ty[0] = c.sy[len + 2];
+  c.tz[0] = c.sz[len + 2];
+  const std::vector<int> begins = {len * 1, len * 4, len * 6, len * 2};
+  Cloud listed = c;
+  for (auto* v : {&listed.sx, &listed.sy, &listed.sz, &listed.qx, &listed.qy, &listed.qz}) v->clear();
+  for (int b : begins)
+    for (int p = b; p < b + len; ++p) {
+      listed.sx.push_back(c.sx[p]);
+      listed.sy.push_back(c.sy[p]);
+      listed.sz.push_back(c.sz[p]);
+      listed.qx.push_back(c.qx[p]);
+      listed.qy.push_back(c.qy[p]);
+      listed.qz.push_back(c.qz[p]);
+    }
+  std::vector<double> rx, ry, rz;
+  reference(listed, rx, ry, rz);
+  const double x0[3] = {c.tx[0], c.ty[0], c.tz[0]};
+  double u[3] = {1.0, -2.0, 0.5};  // added to
+  sum_blocks(x0, c.sources(), begins.data(), static_cast<int>(begins.size()), len, u);
+  const std::vector<double> ux = {u[0] - 1.0}, uy = {u[1] + 2.0}, uz = {u[2] - 0.5};
+  EXPECT_LT(max_rel(ux, uy, uz, rx, ry, rz), 1e-13);
+  EXPECT_TRUE(std::isfinite(u[0]) && std::isfinite(u[1]) && std::isfinite(u[2]));
+
+  c.sy[4 * len + 1] = std::numeric_limits<double>::quiet_NaN();
+  double un[3] = {0.0, 0.0, 0.0};
+  sum_blocks(x0, c.sources(), begins.data(), static_cast<int>(begins.size()), len, un);
+  EXPECT_TRUE(std::isnan(un[0]));
+}
+
 TEST(StokesletKernel, Level2ProblemFastEqualsPlain) {
   const KernelProblem p = make_kernel_problem(2);
   EXPECT_EQ(p.num_targets(), 642);

@@ -1,0 +1,141 @@
+#include "solver/dynamics/flow_benchmark.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "solver/config/case_config.h"
+#include "solver/dynamics/capsule_flow.h"
+#include "solver/stokes/source_layout.h"
+
+namespace capsim::dynamics {
+namespace {
+
+double now_ms() {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// A smooth deformation of the reference; `symmetric` keeps x3 → −x3 (even in x3 for x1, x2; odd for x3).
+Eigen::Matrix3Xd deformed(const Eigen::Matrix3Xd& ref, bool symmetric) {
+  Eigen::Matrix3Xd x = ref;
+  for (int i = 0; i < x.cols(); ++i) {
+    const double x1 = ref(0, i), x2 = ref(1, i), x3 = ref(2, i);
+    const double s3 = symmetric ? x3 * x3 : x3;
+    x(0, i) = x1 * (1.0 + 0.08 * std::sin(1.3 * x2 + 0.4 * s3));
+    x(1, i) = x2 + 0.05 * std::cos(x1) + 0.03 * s3;
+    x(2, i) = x3 * (1.0 - 0.04 * x1);
+  }
+  return x;
+}
+
+FlowBenchScene measure_scene(CapsuleFlow& flow, const Eigen::Matrix3Xd& x, const std::string& name, int repeat) {
+  FlowBenchScene sc;
+  sc.name = name;
+  sc.nodes = static_cast<int>(x.cols());
+  Eigen::Matrix3Xd v, q;
+  const FlowEvaluation ev = flow.velocity(x, v, &q);  // warm-up: first-touch allocation, and q for the bare sum
+  stokes::SingleLayer& op = flow.single_layer();
+  sc.used_symmetry = ev.used_symmetry;
+
+  // The bare regular sum: the same targets (the ones the evaluation chose) and the same sources, copied so
+  // that the evaluations in between cannot touch them.
+  const std::vector<int>& ids = op.last_targets();
+  sc.targets = static_cast<int>(ids.size());
+  sc.sources = op.num_quadrature_points();
+  stokes::AlignedVector tx(ids.size()), ty(ids.size()), tz(ids.size()), ux(ids.size()), uy(ids.size()),
+      uz(ids.size());
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    tx[k] = x(0, ids[k]);
+    ty[k] = x(1, ids[k]);
+    tz[k] = x(2, ids[k]);
+  }
+  const stokes::kernel::Sources s0 = op.build_sources(x, q);
+  stokes::SourceArrays src;
+  src.x.assign(s0.x, s0.x + s0.n);
+  src.y.assign(s0.y, s0.y + s0.n);
+  src.z.assign(s0.z, s0.z + s0.n);
+  src.qx.assign(s0.qx, s0.qx + s0.n);
+  src.qy.assign(s0.qy, s0.qy + s0.n);
+  src.qz.assign(s0.qz, s0.qz + s0.n);
+  const stokes::kernel::Targets tg{tx.data(), ty.data(), tz.data(), sc.targets};
+  const stokes::kernel::Result res{ux.data(), uy.data(), uz.data()};
+  const stokes::kernel::FastConfig fast = op.options().fast;
+  stokes::kernel::sum_fast(tg, src.sources(), res, fast);  // warm-up
+
+  // Alternate evaluation and bare sum, so that both see the same machine state.
+  std::vector<double> eval_ms, bare_ms;
+  const FlowTimings before = flow.timings();
+  for (int r = 0; r < repeat; ++r) {
+    double t0 = now_ms();
+    flow.velocity(x, v);
+    eval_ms.push_back(now_ms() - t0);
+    t0 = now_ms();
+    stokes::kernel::sum_fast(tg, src.sources(), res, fast);
+    bare_ms.push_back(now_ms() - t0);
+  }
+  const FlowTimings& after = flow.timings();
+  sc.repeat = repeat;
+  sc.evaluation_ms = median(eval_ms);
+  sc.regular_sum_ms = median(bare_ms);
+  sc.overhead_ratio = sc.evaluation_ms / sc.regular_sum_ms;
+  const double per = 1e3 / repeat;
+  sc.membrane_ms = per * (after.membrane_s - before.membrane_s);
+  sc.load_ms = per * (after.load_s - before.load_s);
+  sc.layout_ms = per * (after.layout_s - before.layout_s);
+  sc.regular_ms = per * (after.regular_s - before.regular_s);
+  sc.far_ms = per * (after.far_s - before.far_s);
+  sc.singular_ms = per * (after.singular_s - before.singular_s);
+  sc.near_ms = per * (after.near_s - before.near_s);
+  sc.volume_ms = per * (after.volume_s - before.volume_s);
+  double mean_eval = 0.0;
+  for (double t : eval_ms) mean_eval += t / repeat;
+  sc.other_ms = mean_eval - (sc.membrane_ms + sc.load_ms + sc.layout_ms + sc.regular_ms + sc.far_ms +
+                             sc.singular_ms + sc.near_ms + sc.volume_ms);
+  return sc;
+}
+
+}  // namespace
+
+bool FlowBenchOptions::valid(std::string* why) const {
+  if (level < 1 || level > 6) {
+    if (why) *why = "level must be 1..6, got " + std::to_string(level);
+    return false;
+  }
+  if (repeat < 0 || repeat > 100000) {
+    if (why) *why = "repeat must be 0 (automatic) .. 100000, got " + std::to_string(repeat);
+    return false;
+  }
+  return true;
+}
+
+FlowBenchReport bench_flow(const FlowBenchOptions& options) {
+  if (std::string why; !options.valid(&why)) throw std::invalid_argument("bench flow: " + why);
+  config::CaseConfig c;
+  c.aspect_ratio = 2.0;
+  c.law = "skalak";
+  c.capillary_number = 0.3;
+  c.level = options.level;
+  CapsuleFlow flow(c);
+  FlowBenchReport report;
+  report.level = options.level;
+  report.threads = omp_get_max_threads();
+  report.isa = stokes::kernel::kernel_isa();
+  // Automatic repeat: the level-3 general evaluation takes ≈ 10–50 ms; the cost grows ≈ 4–8× per level.
+  const int repeat =
+      options.repeat > 0 ? options.repeat : std::clamp(static_cast<int>(40.0 * std::pow(4.0, 3 - options.level)), 5, 400);
+  for (const bool symmetric : {true, false})
+    report.scenes.push_back(measure_scene(flow, deformed(flow.reference(), symmetric),
+                                          symmetric ? "symmetric" : "general", repeat));
+  return report;
+}
+
+}  // namespace capsim::dynamics

@@ -1,0 +1,66 @@
+#pragma once
+/// @file
+/// @brief The cost of one flow evaluation by named phase, measured beside the bare regular Stokeslet sum over
+/// the same targets and sources in the same run (issue 13 §1; `capsim bench flow`).
+///
+/// The regular sum is the irreducible part of an evaluation: every target against every quadrature point,
+/// O(N²). Everything else (point layout, the singular and near-singular corrections, the membrane, the load
+/// solve, the volume correction) is overhead that a good implementation keeps small next to it. The figure
+/// of merit is therefore the ratio
+///     overhead_ratio = evaluation time / bare regular-sum time,
+/// both medians of timings taken alternately in one process, so that the ratio does not depend on the
+/// machine's speed or on what else runs (measured absolute times do: compare them within one run only).
+///
+/// Two scenes, both the a/b = 2 Skalak capsule at Ca = 0.3 with a smooth deformation: "symmetric" keeps the
+/// x3 → −x3 mirror symmetry (the boundary integral evaluates half the targets, as in every run that starts
+/// in the shear plane), "general" breaks it (all targets).
+
+#include <string>
+#include <vector>
+
+namespace capsim::dynamics {
+
+/// @brief What to measure.
+struct FlowBenchOptions {
+  int level = 3;   ///< mesh level (1..6)
+  int repeat = 0;  ///< timed evaluations per scene; 0 = automatic (about a second per scene, 5..400)
+  /// @brief Whether the options are usable; if not and why is not null, *why says which and why.
+  [[nodiscard]] bool valid(std::string* why = nullptr) const;
+};
+
+/// @brief One scene's measurement. Times are milliseconds per evaluation.
+struct FlowBenchScene {
+  std::string name;             ///< "symmetric" or "general"
+  int nodes = 0;                ///< mesh nodes N
+  int targets = 0;              ///< targets the boundary integral evaluated (N, or about N/2 with symmetry)
+  int sources = 0;              ///< regular quadrature points (unpadded)
+  bool used_symmetry = false;   ///< whether the evaluation used the mirror symmetry
+  int repeat = 0;               ///< timed evaluations (and as many bare sums)
+  double evaluation_ms = 0.0;   ///< median wall time of CapsuleFlow::velocity
+  double regular_sum_ms = 0.0;  ///< median wall time of the bare kernel::sum_fast over the same targets/sources
+  double overhead_ratio = 0.0;  ///< evaluation_ms / regular_sum_ms
+  // Mean time per evaluation of each named phase (CapsuleFlow / SingleLayer timers).
+  double membrane_ms = 0.0;     ///< kinematics and energy gradient R = ∂W/∂x
+  double load_ms = 0.0;         ///< mass matrix assembly and M q = R
+  double layout_ms = 0.0;       ///< symmetry check, quadrature points as SoA
+  double regular_ms = 0.0;      ///< regular Stokeslet sum inside the evaluation
+  double far_ms = 0.0;          ///< far-field tier (0 when off, the default)
+  double singular_ms = 0.0;     ///< Duffy correction
+  double near_ms = 0.0;         ///< near-singular correction and mirror
+  double volume_ms = 0.0;       ///< velocity assembly, node normals, flux, volume correction
+  double other_ms = 0.0;        ///< mean evaluation time not in a named phase (timers, copies)
+};
+
+/// @brief The measurement of both scenes at one level.
+struct FlowBenchReport {
+  int level = 0;
+  int threads = 0;              ///< OpenMP threads (omp_get_max_threads at the call)
+  std::string isa;              ///< instruction set of the Stokeslet kernel
+  std::vector<FlowBenchScene> scenes;
+};
+
+/// @brief Measure (see the file comment). Runs on the current OpenMP thread count.
+/// @throws std::invalid_argument if !options.valid().
+FlowBenchReport bench_flow(const FlowBenchOptions& options);
+
+}  // namespace capsim::dynamics

@@ -73,15 +73,28 @@ FlowEvaluation CapsuleFlow::velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd
   if (background_flow_) v.row(0) += x.row(1);
   // Discrete flux of v and of the node normals through the P2 surface; remove the spurious part.
   normals_ = mesh::node_normals(*mesh_, x);
-  double flux_v = 0.0, flux_n = 0.0;
-  for (const auto& el : mesh_->elements) {
+  // Per element in parallel, then summed in element order (deterministic for any thread count).
+  const int ne = mesh_->num_elements();
+  flux_v_.resize(static_cast<std::size_t>(ne));
+  flux_n_.resize(static_cast<std::size_t>(ne));
+#pragma omp parallel for schedule(static)
+  for (int e = 0; e < ne; ++e) {
+    const auto& el = mesh_->elements[e];
+    double fv = 0.0, fn = 0.0;
     for (int k = 0; k < flux_rule_.size(); ++k) {
       const auto [g1, g2] = flux_rule_.tangents(x, el, k);
       const Eigen::Vector3d vq = flux_rule_.interpolate(v, el, k), nq = flux_rule_.interpolate(normals_, el, k);
       const Eigen::Vector3d nda = flux_rule_.weight(k) * g1.cross(g2);
-      flux_v += vq.dot(nda);
-      flux_n += nq.dot(nda);
+      fv += vq.dot(nda);
+      fn += nq.dot(nda);
     }
+    flux_v_[e] = fv;
+    flux_n_[e] = fn;
+  }
+  double flux_v = 0.0, flux_n = 0.0;
+  for (int e = 0; e < ne; ++e) {
+    flux_v += flux_v_[e];
+    flux_n += flux_n_[e];
   }
   out.volume_flux = flux_v;
   if (volume_correction_) v -= (flux_v / flux_n) * normals_;

@@ -14,6 +14,7 @@
 /// normal velocity of the size of the discretisation error, vanishing under refinement.
 
 #include <memory>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -94,6 +95,7 @@ class CapsuleFlow {
   // Rule of the flux integral: shape functions and derivatives at its points, weights · ½.
   mesh::P2Tabulation flux_rule_;  // degree-6 rule of the volume-flux integral
   Eigen::Matrix3Xd normals_;
+  std::vector<double> flux_v_, flux_n_;  // per-element fluxes of the volume correction
 };
 
 /// @brief Stable time step of the explicit two-stage scheme (rk2):

@@ -5,7 +5,8 @@
 #include <string>
 
 #include <Eigen/CholmodSupport>
-#include <Eigen/IterativeLinearSolvers>
+#include <cmath>
+#include <vector>
 
 #include "solver/membrane/membrane_mechanics.h"  // DegenerateSurface
 #include "solver/mesh/p2_tabulation.h"
@@ -14,8 +15,10 @@ namespace capsim::membrane {
 
 struct LoadSolver::Impl {
   Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> cholmod;
-  // One CG per load component, so the three solves run side by side in one parallel region (below).
-  std::array<Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper>, 3> cg;
+  std::vector<double> inv_diag;                              // Jacobi preconditioner of the CG backend
+  std::vector<double> r, z, p, t;                            // CG work arrays, node-major (3 per node)
+  std::vector<double> local;                                 // element mass matrices of the last assembly
+  std::vector<double> partial;                               // CG: per-block partial dot products
   mesh::P2Tabulation p2;                                     // the rule's points
 };
 
@@ -58,18 +61,26 @@ void LoadSolver::assemble(const Eigen::Matrix3Xd& x) {
   double* val = M_.valuePtr();
   std::fill(val, val + M_.nonZeros(), 0.0);
   const mesh::P2Tabulation& p2 = impl_->p2;
-  const int nq = p2.size();
-  for (int e = 0; e < mesh_.num_elements(); ++e) {
+  const int nq = p2.size(), ne = mesh_.num_elements();
+  // Element matrices in parallel, then added into M serially in element order: the same additions in the
+  // same order as a serial loop, for any thread count.
+  std::vector<double>& local = impl_->local;
+  local.assign(static_cast<std::size_t>(ne) * 36, 0.0);
+#pragma omp parallel for schedule(static)
+  for (int e = 0; e < ne; ++e) {
     const auto& el = mesh_.elements[e];
-    double local[36] = {};
+    double* le = local.data() + static_cast<std::size_t>(e) * 36;
     for (int q = 0; q < nq; ++q) {
       const double da = p2.weight(q) * p2.area_element(x, el, q);
       const double* N = p2[q].n;
       for (int i = 0; i < 6; ++i)
-        for (int j = 0; j < 6; ++j) local[i * 6 + j] += da * N[i] * N[j];
+        for (int j = 0; j < 6; ++j) le[i * 6 + j] += da * N[i] * N[j];
     }
+  }
+  for (int e = 0; e < ne; ++e) {
     const int* slot = value_index_.data() + static_cast<std::size_t>(e) * 36;
-    for (int k = 0; k < 36; ++k) val[slot[k]] += local[k];
+    const double* le = local.data() + static_cast<std::size_t>(e) * 36;
+    for (int k = 0; k < 36; ++k) val[slot[k]] += le[k];
   }
 }
 
@@ -79,12 +90,14 @@ void LoadSolver::factorize() {
     if (impl_->cholmod.info() != Eigen::Success)
       throw DegenerateSurface("CHOLMOD: the mass matrix is not positive definite (surface degenerated)");
   } else {
-    for (auto& cg : impl_->cg) {
-      cg.setTolerance(options_.cg_tolerance);
-      cg.compute(M_);
-    }
+    const int n = static_cast<int>(M_.cols());
+    impl_->inv_diag.resize(static_cast<std::size_t>(n));
+    const Eigen::VectorXd d = M_.diagonal();
+    for (int i = 0; i < n; ++i) impl_->inv_diag[i] = d[i] > 0.0 ? 1.0 / d[i] : 1.0;  // as Eigen's Jacobi
   }
 }
+
+
 
 void LoadSolver::solve(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
   const Eigen::MatrixX3d rhs = R.transpose();
@@ -94,32 +107,176 @@ void LoadSolver::solve(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
     // CHOLMOD's positive-definiteness test lets a NaN matrix through (NaN pivots compare false).
     if (!q.allFinite()) throw DegenerateSurface("CHOLMOD: non-finite load (surface degenerated)");
   } else {
-    // The three components are independent solves: one parallel region for all of them, each CG serial
-    // inside it (Eigen's own parallel product is skipped in a nested region). Left to Eigen, every CG
-    // iteration opens its own parallel region for one sparse product (≈ 80 tiny regions per load solve); with
-    // OpenMP's spin-waiting those regions collapse when another process shares the cores (issue 12 item 13,
-    // results/benchmarks.md). A row of the product is summed in the same order either way, so q is bitwise
-    // the same as with Eigen's threaded product, for any thread count.
-    Eigen::MatrixX3d sol(R.cols(), 3);
-    int iterations[3] = {0, 0, 0};
-    bool converged[3] = {false, false, false};
-#pragma omp parallel for schedule(static, 1)
-    for (int c = 0; c < 3; ++c) {
-      sol.col(c) = impl_->cg[c].solve(rhs.col(c));
-      iterations[c] = static_cast<int>(impl_->cg[c].iterations());
-      converged[c] = impl_->cg[c].info() == Eigen::Success && sol.col(c).allFinite();
-    }
-    last_iterations_ = iterations[0] + iterations[1] + iterations[2];
-    // M is SPD with a condition number bounded independently of h on any valid surface, so CG converges in
-    // a few dozen iterations; not converging means M is not SPD (a NaN position, a collapsed surface).
-    // (Thrown here, not inside the parallel region, which an exception must not leave.)
-    for (int c = 0; c < 3; ++c)
-      if (!converged[c])
-        throw DegenerateSurface("CG: the load solve did not converge (residual " + std::to_string(impl_->cg[c].error()) +
-                                " after " + std::to_string(impl_->cg[c].iterations()) +
-                                " iterations): the mass matrix is not positive definite (surface degenerated)");
-    q = sol.transpose();
+    solve_cg(R, q);
   }
+}
+
+void LoadSolver::solve_cg(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
+  // Jacobi-preconditioned CG from a zero guess on the three load components side by side: three independent
+  // CGs (each with its own α, β and stopping test |r_c| < tol |R_c|, Eigen's criterion) that share every
+  // pass over M. A component that has converged is frozen.
+  //
+  // One parallel region for the whole solve, rows split between the threads, two barriers per iteration
+  // (with passive waiting a barrier costs ≈ 10 µs, so the textbook four would cost as much as they save):
+  // the product t = M p is carried as t ← M z + β t, so that p and t are updated row by row in one sweep
+  // once z is complete:
+  //   sweep 1: x += α p, r −= α t, z = D⁻¹ r; |r|², r·z          (barrier; β = (r·z)_new / (r·z)_old)
+  //   sweep 2: p = z + β p, t = M z + β t; p·t                   (barrier; α = r·z / p·t)
+  // The dot products are summed per fixed block of rows (kBlock, independent of the thread count) and the
+  // block sums added in block order by every thread alike, so q is bitwise the same for any thread count
+  // and a resumed run repeats an uninterrupted one. Each sweep writes its own partial-sum array, so the next
+  // sweep can start while another thread still reads the previous sums.
+  constexpr int kBlock = 256;
+  const int n = static_cast<int>(R.cols());
+  const int nb = (n + kBlock - 1) / kBlock;
+  const std::size_t m = 3 * static_cast<std::size_t>(n);
+  Impl& w = *impl_;
+  for (auto* v : {&w.r, &w.z, &w.p, &w.t}) v->resize(m);
+  w.partial.assign(static_cast<std::size_t>(nb) * 9, 0.0);
+  q.setZero(3, n);
+  double* x = q.data();
+  double *r = w.r.data(), *z = w.z.data(), *p = w.p.data(), *t = w.t.data();
+  double* part_rr = w.partial.data();           // |r|² per block (and |b|² at the start)
+  double* part_rz = part_rr + 3 * nb;           // r·z per block
+  double* part_pt = part_rz + 3 * nb;           // p·t per block
+  const double* d = w.inv_diag.data();
+  const double* b = R.data();
+  const int* outer = M_.outerIndexPtr();
+  const int* inner = M_.innerIndexPtr();
+  const double* val = M_.valuePtr();
+  // M is SPD with a condition number bounded independently of h on any valid surface, so CG converges in a
+  // few dozen iterations; the cap (twice the unknowns, as Eigen's) is reached only if M is not SPD.
+  const int max_iterations = 2 * n;
+  double threshold[3] = {0, 0, 0}, residual2[3] = {0, 0, 0};
+  bool active[3] = {false, false, false};
+  int iterations[3] = {0, 0, 0};
+  auto total = [nb](const double* part, int c) {  // Σ over blocks in block order
+    double s = 0.0;
+    for (int k = 0; k < nb; ++k) s += part[3 * k + c];
+    return s;
+  };
+  // (M y)_i for row i, three components.
+  auto row_product = [&](const double* y, int i, double out[3]) {
+    double a0 = 0.0, a1 = 0.0, a2 = 0.0;
+    for (int e = outer[i]; e < outer[i + 1]; ++e) {
+      const double mv = val[e];
+      const double* yj = y + 3 * inner[e];
+      a0 += mv * yj[0];
+      a1 += mv * yj[1];
+      a2 += mv * yj[2];
+    }
+    out[0] = a0;
+    out[1] = a1;
+    out[2] = a2;
+  };
+#pragma omp parallel
+  {
+    double th[3], rz[3], alpha[3], res[3] = {0, 0, 0};
+    bool act[3];
+    int its[3] = {0, 0, 0};
+    // Start: r = b, z = D⁻¹ r, p = z; |b|², r·z.
+#pragma omp for schedule(static)
+    for (int k = 0; k < nb; ++k) {
+      double bb[3] = {0, 0, 0}, s[3] = {0, 0, 0};
+      for (int i = k * kBlock; i < std::min(n, (k + 1) * kBlock); ++i)
+        for (int c = 0; c < 3; ++c) {
+          const double bi = b[3 * i + c];
+          r[3 * i + c] = bi;
+          z[3 * i + c] = d[i] * bi;
+          p[3 * i + c] = z[3 * i + c];
+          bb[c] += bi * bi;
+          s[c] += bi * z[3 * i + c];
+        }
+      for (int c = 0; c < 3; ++c) {
+        part_rr[3 * k + c] = bb[c];
+        part_rz[3 * k + c] = s[c];
+      }
+    }
+    for (int c = 0; c < 3; ++c) {
+      const double bb = total(part_rr, c);
+      th[c] = options_.cg_tolerance * options_.cg_tolerance * bb;
+      rz[c] = total(part_rz, c);
+      act[c] = bb > 0.0;  // a zero component has the solution 0
+    }
+    // t = M p, p·t.
+#pragma omp for schedule(static)
+    for (int k = 0; k < nb; ++k) {
+      double pt[3] = {0, 0, 0};
+      for (int i = k * kBlock; i < std::min(n, (k + 1) * kBlock); ++i) {
+        row_product(p, i, t + 3 * i);
+        for (int c = 0; c < 3; ++c) pt[c] += p[3 * i + c] * t[3 * i + c];
+      }
+      for (int c = 0; c < 3; ++c) part_pt[3 * k + c] = pt[c];
+    }
+    for (int c = 0; c < 3; ++c) alpha[c] = act[c] ? rz[c] / total(part_pt, c) : 0.0;
+    for (int it = 0; it < max_iterations && (act[0] || act[1] || act[2]); ++it) {
+      // Sweep 1 (the frozen components keep x and r; their z and sums are computed but unused).
+#pragma omp for schedule(static)
+      for (int k = 0; k < nb; ++k) {
+        double rr[3] = {0, 0, 0}, s[3] = {0, 0, 0};
+        for (int i = k * kBlock; i < std::min(n, (k + 1) * kBlock); ++i)
+          for (int c = 0; c < 3; ++c) {
+            x[3 * i + c] += alpha[c] * p[3 * i + c];
+            r[3 * i + c] -= alpha[c] * t[3 * i + c];
+            z[3 * i + c] = d[i] * r[3 * i + c];
+            rr[c] += r[3 * i + c] * r[3 * i + c];
+            s[c] += r[3 * i + c] * z[3 * i + c];
+          }
+        for (int c = 0; c < 3; ++c) {
+          part_rr[3 * k + c] = rr[c];
+          part_rz[3 * k + c] = s[c];
+        }
+      }
+      double beta[3] = {0, 0, 0};
+      for (int c = 0; c < 3; ++c) {
+        if (!act[c]) continue;
+        ++its[c];
+        res[c] = total(part_rr, c);
+        if (!(res[c] >= th[c])) {  // converged (or NaN: caught below)
+          act[c] = false;
+          alpha[c] = 0.0;
+          continue;
+        }
+        const double s = total(part_rz, c);
+        beta[c] = s / rz[c];
+        rz[c] = s;
+      }
+      if (!(act[0] || act[1] || act[2])) break;
+      // Sweep 2.
+#pragma omp for schedule(static)
+      for (int k = 0; k < nb; ++k) {
+        double pt[3] = {0, 0, 0};
+        for (int i = k * kBlock; i < std::min(n, (k + 1) * kBlock); ++i) {
+          double mz[3];
+          row_product(z, i, mz);
+          for (int c = 0; c < 3; ++c) {
+            if (!act[c]) continue;
+            p[3 * i + c] = z[3 * i + c] + beta[c] * p[3 * i + c];
+            t[3 * i + c] = mz[c] + beta[c] * t[3 * i + c];
+            pt[c] += p[3 * i + c] * t[3 * i + c];
+          }
+        }
+        for (int c = 0; c < 3; ++c) part_pt[3 * k + c] = pt[c];
+      }
+      for (int c = 0; c < 3; ++c) alpha[c] = act[c] ? rz[c] / total(part_pt, c) : 0.0;
+    }
+#pragma omp single
+    for (int c = 0; c < 3; ++c) {
+      threshold[c] = th[c];
+      residual2[c] = res[c];
+      active[c] = act[c];
+      iterations[c] = its[c];
+    }
+  }
+  last_iterations_ = iterations[0] + iterations[1] + iterations[2];
+  // Not converging, or a NaN anywhere, means M is not SPD (a NaN position, a collapsed surface).
+  for (int c = 0; c < 3; ++c)
+    if (active[c] || !std::isfinite(residual2[c]) || !q.row(c).allFinite())
+      throw DegenerateSurface("CG: the load solve did not converge (relative residual " +
+                              std::to_string(std::sqrt(residual2[c] / std::max(threshold[c], 1e-300)) *
+                                             options_.cg_tolerance) +
+                              " after " + std::to_string(iterations[c]) +
+                              " iterations): the mass matrix is not positive definite (surface degenerated)");
 }
 
 void LoadSolver::compute_load(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {

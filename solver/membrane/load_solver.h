@@ -58,6 +58,7 @@ class LoadSolver {
   [[nodiscard]] int last_iterations() const { return last_iterations_; }
 
  private:
+  void solve_cg(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q);
   struct Impl;
   const mesh::SurfaceMesh& mesh_;
   Options options_;

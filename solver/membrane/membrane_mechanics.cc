@@ -1,10 +1,12 @@
 #include "solver/membrane/membrane_mechanics.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 
 namespace capsim::membrane {
@@ -49,6 +51,25 @@ MembraneMechanics::MembraneMechanics(const mesh::SurfaceMesh& mesh, const Eigen:
   }
 }
 
+namespace {
+// Kinematics of element el at point q of the tabulation; false if the element collapsed or is non-finite.
+bool point_kinematics(const mesh::P2Tabulation& p2, const Eigen::Matrix3Xd& x, const std::array<int, 6>& el, int q,
+                      PointKinematics& k) {
+  const mesh::Tangents g = p2.tangents(x, el, q);
+  k.g1 = g.g1;
+  k.g2 = g.g2;
+  k.g11 = k.g1.dot(k.g1);
+  k.g12 = k.g1.dot(k.g2);
+  k.g22 = k.g2.dot(k.g2);
+  k.det_g = k.g11 * k.g22 - k.g12 * k.g12;
+  return k.det_g > 0.0;
+}
+
+[[noreturn]] void collapsed(int e) {
+  throw DegenerateSurface("membrane: element " + std::to_string(e) + " collapsed or non-finite");
+}
+}  // namespace
+
 template <class Visit>
 void MembraneMechanics::for_each_point(const Eigen::Matrix3Xd& x, Visit&& visit) const {
   const int nq = p2_.size();
@@ -56,15 +77,7 @@ void MembraneMechanics::for_each_point(const Eigen::Matrix3Xd& x, Visit&& visit)
     const auto& el = mesh_.elements[e];
     for (int q = 0; q < nq; ++q) {
       PointKinematics k;
-      const mesh::Tangents g = p2_.tangents(x, el, q);
-      k.g1 = g.g1;
-      k.g2 = g.g2;
-      k.g11 = k.g1.dot(k.g1);
-      k.g12 = k.g1.dot(k.g2);
-      k.g22 = k.g2.dot(k.g2);
-      k.det_g = k.g11 * k.g22 - k.g12 * k.g12;
-      if (!(k.det_g > 0.0))
-        throw DegenerateSurface("membrane: element " + std::to_string(e) + " collapsed or non-finite");
+      if (!point_kinematics(p2_, x, el, q, k)) collapsed(e);
       visit(e, q, ref_[static_cast<std::size_t>(e) * nq + q], k);
     }
   }
@@ -92,31 +105,66 @@ Invariants invariants(const Ref& r, const PointKinematics& k) {
 }  // namespace
 
 MembraneState MembraneMechanics::evaluate(const Eigen::Matrix3Xd& x) const {
+  // Two phases, so that the result is bitwise the same for any thread count: (1) in parallel over elements,
+  // each element's forces on its six nodes, energy and tension extremes into its own slot; (2) serially in
+  // element order, the sums over elements. Per-call buffers keep evaluate() const and thread-safe.
+  const int ne = mesh_.num_elements(), nq = p2_.size();
+  std::vector<double> force(static_cast<std::size_t>(ne) * 18), energy(static_cast<std::size_t>(ne)),
+      lo(static_cast<std::size_t>(ne)), hi(static_cast<std::size_t>(ne));
+  int first_collapsed = ne;
+#pragma omp parallel for schedule(static) reduction(min : first_collapsed)
+  for (int e = 0; e < ne; ++e) {
+    const auto& el = mesh_.elements[e];
+    double fe[6][3] = {}, we = 0.0;
+    double tmin = std::numeric_limits<double>::infinity(), tmax = -std::numeric_limits<double>::infinity();
+    for (int q = 0; q < nq; ++q) {
+      PointKinematics k;
+      if (!point_kinematics(p2_, x, el, q, k)) {
+        first_collapsed = std::min(first_collapsed, e);
+        break;
+      }
+      const RefPoint& r = ref_[static_cast<std::size_t>(e) * nq + q];
+      const Invariants inv = invariants(r, k);
+      we += r.weight0 * law_.energy(inv.I1, inv.Js);
+      const EnergyDerivatives d = law_.derivatives(inv.I1, inv.Js);
+      const double tau0 = 2.0 * d.d_I1 * inv.l1 / inv.l2 + d.d_Js, tau1 = 2.0 * d.d_I1 * inv.l2 / inv.l1 + d.d_Js;
+      // λ1 ≥ λ2 does not order the tensions: Skalak's τ1 − τ2 = (λ1² + λ2² − 1)(λ1/λ2 − λ2/λ1) is negative
+      // under strong compression (solver/README.md §2), so both are compared.
+      tmin = std::min({tmin, tau0, tau1});
+      tmax = std::max({tmax, tau0, tau1});
+      // A^{αβ} = 2 ws_I1 G^{αβ} + ws_J Js g^{αβ}, with g^{αβ} the inverse current metric.
+      const double ginv11 = k.g22 / k.det_g, ginv12 = -k.g12 / k.det_g, ginv22 = k.g11 / k.det_g;
+      const double c1 = 2.0 * d.d_I1, c2 = d.d_Js * inv.Js;
+      const double A11 = c1 * r.Ginv[0] + c2 * ginv11;
+      const double A12 = c1 * r.Ginv[1] + c2 * ginv12;
+      const double A22 = c1 * r.Ginv[2] + c2 * ginv22;
+      // R_a += w0 (A^{1β} g_β ∂N_a/∂ξ + A^{2β} g_β ∂N_a/∂η).
+      const Eigen::Vector3d t1 = r.weight0 * (A11 * k.g1 + A12 * k.g2);
+      const Eigen::Vector3d t2 = r.weight0 * (A12 * k.g1 + A22 * k.g2);
+      for (int a = 0; a < 6; ++a)
+        for (int c = 0; c < 3; ++c) fe[a][c] += p2_[q].dxi[a] * t1[c] + p2_[q].deta[a] * t2[c];
+    }
+    double* out = force.data() + static_cast<std::size_t>(e) * 18;
+    for (int a = 0; a < 6; ++a)
+      for (int c = 0; c < 3; ++c) out[3 * a + c] = fe[a][c];
+    energy[e] = we;
+    lo[e] = tmin;
+    hi[e] = tmax;
+  }
+  if (first_collapsed < ne) collapsed(first_collapsed);  // the lowest such element, as a serial loop would
   MembraneState s;
   s.internal_force = Eigen::Matrix3Xd::Zero(3, x.cols());
   s.tau_min = std::numeric_limits<double>::infinity();
   s.tau_max = -std::numeric_limits<double>::infinity();
-  for_each_point(x, [&](int e, int q, const RefPoint& r, const PointKinematics& k) {
-    const Invariants inv = invariants(r, k);
-    s.energy += r.weight0 * law_.energy(inv.I1, inv.Js);
-    const EnergyDerivatives d = law_.derivatives(inv.I1, inv.Js);
-    const auto tau = std::array<double, 2>{2.0 * d.d_I1 * inv.l1 / inv.l2 + d.d_Js, 2.0 * d.d_I1 * inv.l2 / inv.l1 + d.d_Js};
-    // λ1 ≥ λ2 does not order the tensions: Skalak's τ1 − τ2 = (λ1² + λ2² − 1)(λ1/λ2 − λ2/λ1) is negative
-    // under strong compression (solver/README.md §2), so both are compared.
-    s.tau_min = std::min({s.tau_min, tau[0], tau[1]});
-    s.tau_max = std::max({s.tau_max, tau[0], tau[1]});
-    // A^{αβ} = 2 ws_I1 G^{αβ} + ws_J Js g^{αβ}, with g^{αβ} the inverse current metric.
-    const double ginv11 = k.g22 / k.det_g, ginv12 = -k.g12 / k.det_g, ginv22 = k.g11 / k.det_g;
-    const double c1 = 2.0 * d.d_I1, c2 = d.d_Js * inv.Js;
-    const double A11 = c1 * r.Ginv[0] + c2 * ginv11;
-    const double A12 = c1 * r.Ginv[1] + c2 * ginv12;
-    const double A22 = c1 * r.Ginv[2] + c2 * ginv22;
-    // R_a += w0 (A^{1β} g_β ∂N_a/∂ξ + A^{2β} g_β ∂N_a/∂η).
-    const Eigen::Vector3d t1 = r.weight0 * (A11 * k.g1 + A12 * k.g2);
-    const Eigen::Vector3d t2 = r.weight0 * (A12 * k.g1 + A22 * k.g2);
+  for (int e = 0; e < ne; ++e) {
     const auto& el = mesh_.elements[e];
-    for (int a = 0; a < 6; ++a) s.internal_force.col(el[a]) += p2_[q].dxi[a] * t1 + p2_[q].deta[a] * t2;
-  });
+    const double* fe = force.data() + static_cast<std::size_t>(e) * 18;
+    for (int a = 0; a < 6; ++a)
+      for (int c = 0; c < 3; ++c) s.internal_force(c, el[a]) += fe[3 * a + c];
+    s.energy += energy[e];
+    s.tau_min = std::min(s.tau_min, lo[e]);
+    s.tau_max = std::max(s.tau_max, hi[e]);
+  }
   return s;
 }
 

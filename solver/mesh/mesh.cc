@@ -249,12 +249,19 @@ double min_node_spacing(const SurfaceMesh& m, const Eigen::Matrix3Xd& x) {
 
 Eigen::Matrix3Xd node_normals(const SurfaceMesh& m, const Eigen::Matrix3Xd& x) {
   static const P2Tabulation nodes = P2Tabulation::at_nodes();
-  Eigen::Matrix3Xd n = Eigen::Matrix3Xd::Zero(3, x.cols());
-  for (const auto& el : m.elements)
+  // Each element's unit normals at its nodes in parallel, then summed into the nodes serially in element order
+  // (the additions of a serial loop, in its order, for any thread count).
+  const int ne = m.num_elements();
+  std::vector<Eigen::Vector3d> at(static_cast<std::size_t>(ne) * 6);
+#pragma omp parallel for schedule(static)
+  for (int e = 0; e < ne; ++e)
     for (int k = 0; k < 6; ++k) {
-      const auto [g1, g2] = nodes.tangents(x, el, k);
-      n.col(el[k]) += g1.cross(g2).normalized();
+      const auto [g1, g2] = nodes.tangents(x, m.elements[e], k);
+      at[static_cast<std::size_t>(e) * 6 + k] = g1.cross(g2).normalized();
     }
+  Eigen::Matrix3Xd n = Eigen::Matrix3Xd::Zero(3, x.cols());
+  for (int e = 0; e < ne; ++e)
+    for (int k = 0; k < 6; ++k) n.col(m.elements[e][k]) += at[static_cast<std::size_t>(e) * 6 + k];
   n.colwise().normalize();
   return n;
 }

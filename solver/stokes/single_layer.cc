@@ -89,6 +89,18 @@ void SingleLayer::copy_connectivity(const mesh::SurfaceMesh& mesh) {
     }
   }
   if (static_cast<int>(mesh.mirror_node.size()) == num_nodes_) mirror_ = mesh.mirror_node;
+  // Targets in the order of their first element: the mesh's elements come from recursive subdivision
+  // (children of one parent are consecutive), so this order is spatially coherent and consecutive targets
+  // of the correction loops read the same neighbouring elements from cache. Each target's own sums do not
+  // depend on the order, so neither does u.
+  std::vector<int> first(static_cast<std::size_t>(num_nodes_), 0);
+  for (int i = 0; i < num_nodes_; ++i) {
+    first[i] = num_nodes_ > 0 && node_offsets_[i] < node_offsets_[i + 1] ? inc_element_[node_offsets_[i]] : 0;
+    for (int k = node_offsets_[i]; k < node_offsets_[i + 1]; ++k) first[i] = std::min(first[i], inc_element_[k]);
+  }
+  node_order_.resize(static_cast<std::size_t>(num_nodes_));
+  for (int i = 0; i < num_nodes_; ++i) node_order_[i] = i;
+  std::stable_sort(node_order_.begin(), node_order_.end(), [&](int a, int b) { return first[a] < first[b]; });
 }
 
 bool SingleLayer::is_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) const {
@@ -114,7 +126,7 @@ void SingleLayer::select_targets(const Eigen::Matrix3Xd& x, bool symmetric) {
   // All nodes, or one of each mirror pair (the one with the larger x3; a node on the plane is its own
   // image and is evaluated).
   target_ids_.clear();
-  for (int i = 0; i < num_nodes_; ++i) {
+  for (const int i : node_order_) {
     if (symmetric) {
       const int m = mirror_[i];
       const bool mine = m == i || x(2, i) > x(2, m) || (x(2, i) == x(2, m) && i < m);

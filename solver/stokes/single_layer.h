@@ -159,6 +159,7 @@ class SingleLayer {
   std::vector<int> node_offsets_;           // node → incidences CSR
   std::vector<int> inc_element_, inc_local_;
   std::vector<int> mirror_;                 // empty if the mesh has none
+  std::vector<int> node_order_;             // nodes in the order targets are evaluated (spatially coherent)
   std::vector<mesh::P2Point> regular_;      // rule points
   PointTable duffy_[6];                     // Duffy rule per local node position (SoA)
   std::vector<mesh::P2Point> near_rule_;    // subdivided rule, then the regular rule negated (empty if off)

@@ -221,11 +221,12 @@ void SingleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Ma
         const double nx = t1[1] * t2[2] - t1[2] * t2[1], ny = t1[2] * t2[0] - t1[0] * t2[2],
                      nz = t1[0] * t2[1] - t1[1] * t2[0];
         const double nn = nx * nx + ny * ny + nz * nz;
-        const double wj = wt[p] * nn * kernel::rsqrt_arith(nn);  // w |t1 × t2|
-        // r = x0 − x = −d; Duffy points are interior, so r ≠ 0 on a non-degenerate element.
+        // r = x0 − x = −d; Duffy points are interior, so r ≠ 0 on a non-degenerate element. One inverse
+        // square root gives both factors: with a = (|t1 × t2|² r²)^(−1/2), the weight times 1/|r| is
+        // w |t1 × t2| / |r| = w nn a, and 1/r² = nn a².
         const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-        const double inv = kernel::rsqrt_arith(r2);
-        kernel::add_stokeslet(-d[0], -d[1], -d[2], qq[0], qq[1], qq[2], inv, wj, sx, sy, sz);
+        const double a = kernel::rsqrt_arith(nn * r2), na = nn * a;
+        kernel::add_stokeslet_scaled(-d[0], -d[1], -d[2], qq[0], qq[1], qq[2], na * a, wt[p] * na, sx, sy, sz);
       }
       acc[0] += sx;
       acc[1] += sy;

@@ -1,5 +1,6 @@
 #include "solver/stokes/source_layout.h"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -12,7 +13,11 @@ void layout_points(const std::vector<mesh::P2Point>& rule, const std::vector<std
   const int ne = static_cast<int>(elements.size()), nq = static_cast<int>(rule.size());
   const int n = ne * nq;
   const int npad = (n + width - 1) / width * width;
-  for (auto* v : {&out.x, &out.y, &out.z, &out.qx, &out.qy, &out.qz}) v->assign(static_cast<std::size_t>(npad), 0.0);
+  // Every point is written below; only the padding needs its zero load (and a finite position).
+  for (auto* v : {&out.x, &out.y, &out.z, &out.qx, &out.qy, &out.qz}) {
+    v->resize(static_cast<std::size_t>(npad));
+    std::fill(v->begin() + n, v->end(), 0.0);
+  }
   double *px = out.x.data(), *py = out.y.data(), *pz = out.z.data(), *pqx = out.qx.data(), *pqy = out.qy.data(),
          *pqz = out.qz.data();
   // The rule as arrays (ξ, η, w), the element's geometry and load in monomial form (mesh::p2_monomials).

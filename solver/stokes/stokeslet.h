@@ -129,18 +129,22 @@ inline double rsqrt_arith(double x) {
 }
 
 /// @brief The Stokeslet applied to a load, the one scalar definition used by every non-SIMD path:
-///     u += w · J(r)·q,   J(r)·q = (q + r (r·q)/r²) / r,   r = x0 − x,
-/// evaluated as (w·inv_r) (q + r ((r·q) inv_r inv_r)) with inv_r = 1/|r| supplied by the caller (each caller
-/// chooses how to compute it: 1/std::sqrt, rsqrt_arith; inv_r = 0 masks a pair at zero distance). This is the
-/// operation order of the SIMD tiles in stokeslet.cc, so the paths differ only in how 1/r is computed.
+///     u += f · (q + r (r·q) / r²),   i.e. u += w · J(r)·q with f = w / |r|,   r = x0 − x,
+/// with inv_r2 = 1/r² and f supplied by the caller (each caller chooses how to compute them; inv_r2 = f = 0
+/// masks a pair at zero distance). (r·q) · inv_r2 is the operation order of the SIMD tiles in stokeslet.cc.
 /// T is double (inside `omp simd` loops, where it vectorises once inlined) or long double (test references).
 template <class T>
-inline void add_stokeslet(T rx, T ry, T rz, T qx, T qy, T qz, T inv_r, T w, T& ux, T& uy, T& uz) {
-  const T s = (rx * qx + ry * qy + rz * qz) * inv_r * inv_r;
-  const T f = w * inv_r;
+inline void add_stokeslet_scaled(T rx, T ry, T rz, T qx, T qy, T qz, T inv_r2, T f, T& ux, T& uy, T& uz) {
+  const T s = (rx * qx + ry * qy + rz * qz) * inv_r2;
   ux += f * (qx + rx * s);
   uy += f * (qy + ry * s);
   uz += f * (qz + rz * s);
+}
+
+/// @brief The same with inv_r = 1/|r| and the weight w: u += w · J(r)·q, J(r)·q = (q + r (r·q)/r²) / r.
+template <class T>
+inline void add_stokeslet(T rx, T ry, T rz, T qx, T qy, T qz, T inv_r, T w, T& ux, T& uy, T& uz) {
+  add_stokeslet_scaled(rx, ry, rz, qx, qy, qz, inv_r * inv_r, w * inv_r, ux, uy, uz);
 }
 
 }  // namespace kernel

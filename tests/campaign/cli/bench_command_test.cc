@@ -1,0 +1,56 @@
+// `capsim bench flow`: the fields issue 13 asks for, phases that add up to the evaluation, and bad input
+// with exit code 2. Times are not asserted (they depend on the machine); only their consistency is.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/campaign/test_util.h"
+
+namespace capsim::campaign::testing {
+namespace {
+
+TEST(BenchFlow, JsonHasTheRatiosAndPhasesOfBothScenes) {
+  const CmdResult r = sh(exe() + " bench flow --level 1 --threads 1 --repeat 3 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  for (const char* k : {"level", "nodes", "threads", "evaluation_ms", "regular_sum_ms", "overhead_ratio"})
+    EXPECT_TRUE(j.contains(k)) << k;
+  EXPECT_EQ(j["level"], 1);
+  EXPECT_EQ(j["nodes"], 162);
+  EXPECT_EQ(j["threads"], 1);
+  ASSERT_EQ(j["scenes"].size(), 2u);
+  const auto& sym = j["scenes"][0];
+  const auto& gen = j["scenes"][1];
+  EXPECT_EQ(sym["scene"], "symmetric");
+  EXPECT_TRUE(sym["used_symmetry"].get<bool>());
+  EXPECT_FALSE(gen["used_symmetry"].get<bool>());
+  EXPECT_LT(sym["targets"].get<int>(), gen["targets"].get<int>());
+  EXPECT_EQ(gen["targets"], 162);
+  for (const auto& s : {sym, gen}) {
+    double phases = 0.0;
+    for (const char* k : {"membrane_ms", "load_ms", "layout_ms", "regular_ms", "far_ms", "singular_ms", "near_ms",
+                          "volume_ms"}) {
+      ASSERT_TRUE(s.contains(k)) << k;
+      EXPECT_GE(s[k].get<double>(), 0.0) << k;
+      phases += s[k].get<double>();
+    }
+    EXPECT_GT(s["singular_ms"].get<double>(), 0.0);
+    // The named phases account for the evaluation: other_ms is what they miss (mean evaluation − phases).
+    EXPECT_GE(s["other_ms"].get<double>(), -1e-9);
+    EXPECT_NEAR(s["overhead_ratio"].get<double>(),
+                s["evaluation_ms"].get<double>() / s["regular_sum_ms"].get<double>(), 1e-9);
+    EXPECT_GT(phases, 0.0);
+  }
+}
+
+TEST(BenchFlow, BadOptionsExitTwoWithOneMessage) {
+  for (const char* args : {"--level 9", "--level 0", "--level x", "--threads", "--frobnicate"}) {
+    const CmdResult r = sh(exe() + " bench flow " + args);
+    EXPECT_EQ(r.code, 2) << args << ": " << r.err;
+    EXPECT_NE(r.err.find("capsim bench"), std::string::npos) << args << ": " << r.err;
+  }
+  EXPECT_EQ(sh(exe() + " bench nosuch").code, 2);
+}
+
+}  // namespace
+}  // namespace capsim::campaign::testing

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "solver/membrane/membrane_mechanics.h"  // DegenerateSurface
+#include "solver/mesh/p2_element.h"
 #include "solver/mesh/p2_tabulation.h"
 
 namespace capsim::membrane {
@@ -70,12 +71,22 @@ void LoadSolver::assemble(const Eigen::Matrix3Xd& x) {
   for (int e = 0; e < ne; ++e) {
     const auto& el = mesh_.elements[e];
     double* le = local.data() + static_cast<std::size_t>(e) * 36;
+    double X[6][3], C[6][3];
+    for (int a = 0; a < 6; ++a)
+      for (int c = 0; c < 3; ++c) X[a][c] = x(c, el[a]);
+    mesh::p2_monomials3(X, C);
     for (int q = 0; q < nq; ++q) {
-      const double da = p2.weight(q) * p2.area_element(x, el, q);
+      double p[3], g1[3], g2[3];
+      mesh::p2_monomial_geometry(C, p2[q].xi, p2[q].eta, p, g1, g2);
+      const double nx = g1[1] * g2[2] - g1[2] * g2[1], ny = g1[2] * g2[0] - g1[0] * g2[2],
+                   nz = g1[0] * g2[1] - g1[1] * g2[0];
+      const double da = p2.weight(q) * std::sqrt(nx * nx + ny * ny + nz * nz);
       const double* N = p2[q].n;
-      for (int i = 0; i < 6; ++i)
-        for (int j = 0; j < 6; ++j) le[i * 6 + j] += da * N[i] * N[j];
+      for (int i = 0; i < 6; ++i)  // the upper triangle; M_e is symmetric
+        for (int j = i; j < 6; ++j) le[i * 6 + j] += da * N[i] * N[j];
     }
+    for (int i = 0; i < 6; ++i)
+      for (int j = 0; j < i; ++j) le[i * 6 + j] = le[j * 6 + i];
   }
   for (int e = 0; e < ne; ++e) {
     const int* slot = value_index_.data() + static_cast<std::size_t>(e) * 36;

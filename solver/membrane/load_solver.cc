@@ -127,16 +127,15 @@ void LoadSolver::solve_cg(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
   // CGs (each with its own α, β and stopping test |r_c| < tol |R_c|, Eigen's criterion) that share every
   // pass over M. A component that has converged is frozen.
   //
-  // One parallel region for the whole solve, rows split between the threads, two barriers per iteration
-  // (with passive waiting a barrier costs ≈ 10 µs, so the textbook four would cost as much as they save):
-  // the product t = M p is carried as t ← M z + β t, so that p and t are updated row by row in one sweep
-  // once z is complete:
-  //   sweep 1: x += α p, r −= α t, z = D⁻¹ r; |r|², r·z          (barrier; β = (r·z)_new / (r·z)_old)
-  //   sweep 2: p = z + β p, t = M z + β t; p·t                   (barrier; α = r·z / p·t)
-  // The dot products are summed per fixed block of rows (kBlock, independent of the thread count) and the
-  // block sums added in block order by every thread alike, so q is bitwise the same for any thread count
-  // and a resumed run repeats an uninterrupted one. Each sweep writes its own partial-sum array, so the next
-  // sweep can start while another thread still reads the previous sums.
+  // Two sweeps over the rows per iteration (the textbook loop makes four): the product is carried as
+  // t ← M z + β t, so that p and t are updated row by row in one sweep once z is complete:
+  //   sweep 1: x += α p, r −= α t, z = D⁻¹ r; |r|², r·z          (β = (r·z)_new / (r·z)_old)
+  //   sweep 2: p = z + β p, t = M z + β t; p·t                   (α = r·z / p·t)
+  // Serial on purpose: the solve streams M and five vectors through memory twice per iteration and is bound
+  // by memory bandwidth; split between two threads (rows per thread, two barriers per iteration) it ran
+  // slower, 14.2 against 9.1 ms at level 4 and 2.7 against 2.3 ms at level 3 (results/benchmarks.md,
+  // "Flow evaluation by phase"). The dot products are summed per block of kBlock rows and the block sums in
+  // block order (the layout a parallel version would need), and q does not depend on the thread count.
   constexpr int kBlock = 256;
   const int n = static_cast<int>(R.cols());
   const int nb = (n + kBlock - 1) / kBlock;
@@ -180,13 +179,11 @@ void LoadSolver::solve_cg(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
     out[1] = a1;
     out[2] = a2;
   };
-#pragma omp parallel
   {
     double th[3], rz[3], alpha[3], res[3] = {0, 0, 0};
     bool act[3];
     int its[3] = {0, 0, 0};
     // Start: r = b, z = D⁻¹ r, p = z; |b|², r·z.
-#pragma omp for schedule(static)
     for (int k = 0; k < nb; ++k) {
       double bb[3] = {0, 0, 0}, s[3] = {0, 0, 0};
       for (int i = k * kBlock; i < std::min(n, (k + 1) * kBlock); ++i)
@@ -210,7 +207,6 @@ void LoadSolver::solve_cg(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
       act[c] = bb > 0.0;  // a zero component has the solution 0
     }
     // t = M p, p·t.
-#pragma omp for schedule(static)
     for (int k = 0; k < nb; ++k) {
       double pt[3] = {0, 0, 0};
       for (int i = k * kBlock; i < std::min(n, (k + 1) * kBlock); ++i) {
@@ -222,7 +218,6 @@ void LoadSolver::solve_cg(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
     for (int c = 0; c < 3; ++c) alpha[c] = act[c] ? rz[c] / total(part_pt, c) : 0.0;
     for (int it = 0; it < max_iterations && (act[0] || act[1] || act[2]); ++it) {
       // Sweep 1 (the frozen components keep x and r; their z and sums are computed but unused).
-#pragma omp for schedule(static)
       for (int k = 0; k < nb; ++k) {
         double rr[3] = {0, 0, 0}, s[3] = {0, 0, 0};
         for (int i = k * kBlock; i < std::min(n, (k + 1) * kBlock); ++i)
@@ -254,7 +249,6 @@ void LoadSolver::solve_cg(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
       }
       if (!(act[0] || act[1] || act[2])) break;
       // Sweep 2.
-#pragma omp for schedule(static)
       for (int k = 0; k < nb; ++k) {
         double pt[3] = {0, 0, 0};
         for (int i = k * kBlock; i < std::min(n, (k + 1) * kBlock); ++i) {
@@ -271,7 +265,6 @@ void LoadSolver::solve_cg(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
       }
       for (int c = 0; c < 3; ++c) alpha[c] = act[c] ? rz[c] / total(part_pt, c) : 0.0;
     }
-#pragma omp single
     for (int c = 0; c < 3; ++c) {
       threshold[c] = th[c];
       residual2[c] = res[c];

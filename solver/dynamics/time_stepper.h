@@ -68,6 +68,9 @@ class TimeIntegrator {
   [[nodiscard]] virtual std::string name() const = 0;
 };
 
+/// @brief Default safety factor of the RKC stage choice (time.rkc_safety; case_keys.def has the same default).
+inline constexpr double kRkcSafety = 1.25;
+
 /// @brief Heun's method with preallocated stage arrays.
 class Rk2Integrator final : public TimeIntegrator {
  public:
@@ -100,7 +103,7 @@ class RkcIntegrator final : public TimeIntegrator {
  public:
   struct Options {
     double damping = 2.0 / 13.0;  ///< ε of w0 = 1 + ε/s² (SSV's value: β(s) ≈ 0.653 s², strong damping)
-    double safety = 1.25;         ///< ρ used = safety × membrane_spectral_radius (which is itself an upper fit)
+    double safety = kRkcSafety;   ///< ρ used = safety × membrane_spectral_radius (which is itself an upper fit)
     int max_stages = 400;         ///< refuse (StepRejected) beyond: dt far too large for the problem
   };
   RkcIntegrator() : RkcIntegrator(Options{}) {}
@@ -124,8 +127,9 @@ class RkcIntegrator final : public TimeIntegrator {
 /// @brief max |Δx_a − Δx_b| over the corner–mid-side node pairs of every element.
 double max_element_distortion(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& dx);
 
-/// @brief "rk2" | "rkc" → an integrator. @throws std::invalid_argument naming the accepted values.
-std::unique_ptr<TimeIntegrator> make_integrator(const std::string& scheme);
+/// @brief "rk2" | "rkc" → an integrator; @p rkc_safety is RkcIntegrator::Options::safety (time.rkc_safety).
+/// @throws std::invalid_argument naming the accepted values.
+std::unique_ptr<TimeIntegrator> make_integrator(const std::string& scheme, double rkc_safety = kRkcSafety);
 
 /// @brief Upper estimate of the spectral radius of ∂v/∂x on positions x, from the membrane relaxation:
 ///   ρ ≈ kSpectralRadiusConstant · (1 + kPrestressCoefficient · max(τmax, 0)) / (Ca · h_min(x)),

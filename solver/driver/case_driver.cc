@@ -89,7 +89,7 @@ class CaseRun {
     V0_ = membrane::area_and_volume(mesh(), flow_->reference()).volume;
     h_min_ = mesh::min_node_spacing(mesh(), flow_->reference());
     eps_ = 1e-9 * dt_;
-    integrator_ = dynamics::make_integrator(config_.scheme);
+    integrator_ = dynamics::make_integrator(config_.scheme, config_.rkc_safety);
     identity_ = config_.to_toml();
   }
 

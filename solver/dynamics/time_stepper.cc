@@ -122,9 +122,13 @@ double max_element_distortion(const mesh::SurfaceMesh& mesh, const Eigen::Matrix
   return std::sqrt(worst);
 }
 
-std::unique_ptr<TimeIntegrator> make_integrator(const std::string& scheme) {
+std::unique_ptr<TimeIntegrator> make_integrator(const std::string& scheme, double rkc_safety) {
   if (scheme == "rk2") return std::make_unique<Rk2Integrator>();
-  if (scheme == "rkc") return std::make_unique<RkcIntegrator>();
+  if (scheme == "rkc") {
+    RkcIntegrator::Options options;
+    options.safety = rkc_safety;
+    return std::make_unique<RkcIntegrator>(options);
+  }
   throw std::invalid_argument("time.scheme = \"" + scheme + "\" is not known (choose \"rk2\" or \"rkc\")");
 }
 

@@ -11,10 +11,12 @@
 ///    dt ρ ≤ β(s): the cost per unit time grows like sqrt(ρ/dt) instead of ρ, and dt follows accuracy.
 ///
 /// rkc is the default: on the stiff small-Ca cases it needs several times fewer flow evaluations per unit
-/// time than rk2 at an error far below the period-to-period spread; rk2 stays the cheaper scheme for Ca ≳ 1,
-/// where the stiffness is mild and rkc's conservative ρ bound makes it take 3 stages at the rk2 dt. The
-/// measurements (evaluations per unit time, errors against rk2 at half its dt, volume drift) are in
-/// results/benchmarks.md, "Time integration".
+/// time than rk2 at an error far below the period-to-period spread; on level 2 rk2 stays the cheaper scheme
+/// for Ca ≳ 1, where the stiffness is mild and rkc's conservative ρ bound makes it take 3 stages at the rk2
+/// dt. On level 3 rkc's accuracy dt (0.02) is above rk2's stable dt up to Ca = 0.9 at least, and rkc takes
+/// its 2-stage minimum (where rk2, with the same stability interval, could only match it) only at dt ≈ 0.005.
+/// The measurements (evaluations per unit time, errors against rk2 at half its dt, volume drift) are in
+/// results/benchmarks.md, "Time integration" and "Evaluations per unit time (issue 13 §2)".
 
 #include <memory>
 #include <stdexcept>
@@ -68,6 +70,14 @@ class TimeIntegrator {
   [[nodiscard]] virtual std::string name() const = 0;
 };
 
+/// @brief Default safety factor of the RKC stage choice (time.rkc_safety; case_keys.def has the same default).
+/// Measured (issue 13 §2, results/time_steps): along runs of three level-2 cases (Ca = 0.02–0.9, a/b = 0.5 and
+/// 2, both laws) membrane_spectral_radius is 1.17–1.49 × the power-iteration ρ, so with 1.25 the stages cover
+/// ρ 1.46–1.86 times. Safety 1.0 saves 8–11% of the evaluations on the level-3 cases (a) and (b) and changed
+/// D12 by < 1e-6; it is not the default because the level-3 comparison (where the spheroid calibration
+/// above found ρ Ca h_min up to 6.1 against K = 6.5, a 7% margin) and a stability sweep were not done.
+inline constexpr double kRkcSafety = 1.25;
+
 /// @brief Heun's method with preallocated stage arrays.
 class Rk2Integrator final : public TimeIntegrator {
  public:
@@ -100,7 +110,7 @@ class RkcIntegrator final : public TimeIntegrator {
  public:
   struct Options {
     double damping = 2.0 / 13.0;  ///< ε of w0 = 1 + ε/s² (SSV's value: β(s) ≈ 0.653 s², strong damping)
-    double safety = 1.25;         ///< ρ used = safety × membrane_spectral_radius (which is itself an upper fit)
+    double safety = kRkcSafety;   ///< ρ used = safety × membrane_spectral_radius (which is itself an upper fit)
     int max_stages = 400;         ///< refuse (StepRejected) beyond: dt far too large for the problem
   };
   RkcIntegrator() : RkcIntegrator(Options{}) {}
@@ -124,8 +134,9 @@ class RkcIntegrator final : public TimeIntegrator {
 /// @brief max |Δx_a − Δx_b| over the corner–mid-side node pairs of every element.
 double max_element_distortion(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& dx);
 
-/// @brief "rk2" | "rkc" → an integrator. @throws std::invalid_argument naming the accepted values.
-std::unique_ptr<TimeIntegrator> make_integrator(const std::string& scheme);
+/// @brief "rk2" | "rkc" → an integrator; @p rkc_safety is RkcIntegrator::Options::safety (time.rkc_safety).
+/// @throws std::invalid_argument naming the accepted values.
+std::unique_ptr<TimeIntegrator> make_integrator(const std::string& scheme, double rkc_safety = kRkcSafety);
 
 /// @brief Upper estimate of the spectral radius of ∂v/∂x on positions x, from the membrane relaxation:
 ///   ρ ≈ kSpectralRadiusConstant · (1 + kPrestressCoefficient · max(τmax, 0)) / (Ca · h_min(x)),

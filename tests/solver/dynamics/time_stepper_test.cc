@@ -206,6 +206,54 @@ TEST(Integrators, StartFieldsAreTheFieldsOfTheInitialState) {
   }
 }
 
+// The stage count is the smallest s with β(s) ≥ dt · safety · membrane_spectral_radius(x_n), with the safety
+// of time.rkc_safety (make_integrator passes it on): a larger safety takes more stages, never fewer.
+TEST(Rkc, StagesFollowSafetyTimesTheStiffnessEstimate) {
+  EXPECT_EQ(RkcIntegrator::Options{}.safety, kRkcSafety);
+  EXPECT_EQ(config::CaseConfig{}.rkc_safety, kRkcSafety);
+  const double Ca = 0.05;
+  CapsuleFlow flow(make_case(1, Ca, 2.0));
+  const Eigen::Matrix3Xd x0 = perturbed_reference(flow);
+  Eigen::Matrix3Xd v;
+  const FlowEvaluation ev = flow.velocity(x0, v);
+  const double rho = membrane_spectral_radius(flow.mesh(), x0, Ca, ev.tau_max);
+  const double dt = 0.05;
+  int previous = 0, first = 0;
+  for (double safety : {1.0, kRkcSafety, 2.0, 4.0}) {
+    auto integrator = make_integrator("rkc", safety);
+    Eigen::Matrix3Xd x = x0;
+    const StepInfo info = integrator->step(flow, x, dt);
+    const int expected = RkcIntegrator::stages_for(dt * safety * rho, RkcIntegrator::Options{}.damping);
+    EXPECT_EQ(info.stages, expected) << "safety " << safety;
+    EXPECT_EQ(info.evaluations, expected) << "safety " << safety;
+    EXPECT_DOUBLE_EQ(dynamic_cast<RkcIntegrator&>(*integrator).last_spectral_radius(), safety * rho);
+    EXPECT_GE(info.stages, previous) << "safety " << safety;
+    previous = info.stages;
+    if (first == 0) first = info.stages;
+  }
+  EXPECT_GT(previous, first) << "the dt here must make the safety count";
+}
+
+// At the automatic dt of a stiff case the stages the default safety chooses cover the power-iteration
+// spectral radius of the state with a margin: dt · ρ(power iteration) · 1.1 ≤ β(s). (Shear flow, Ca = 0.02,
+// level 1, every mode excited; the level-2/3 states along runs are in spectral_radius_validation.)
+TEST(Rkc, DefaultStagesCoverThePowerIterationSpectralRadius) {
+  for (double ar : {0.5, 2.0}) {
+    config::CaseConfig c = make_case(1, 0.02, ar);
+    CapsuleFlow flow(c);
+    const Eigen::Matrix3Xd x = perturbed_reference(flow);
+    const double dt = automatic_time_step(c, flow.mesh());
+    EXPECT_EQ(dt, c.dt_accuracy) << "the stiff regime: dt set by accuracy";
+    auto rkc = make_integrator("rkc", c.rkc_safety);
+    Eigen::Matrix3Xd y = x;
+    const int s = rkc->step(flow, y, dt).stages;
+    const double truth = estimate_spectral_radius(flow, x, 60);
+    const double beta = RkcIntegrator::stability_boundary(s, RkcIntegrator::Options{}.damping);
+    std::printf("a/b %g: dt %g, %d stages, beta %.1f, dt rho(power iteration) %.1f\n", ar, dt, s, beta, dt * truth);
+    EXPECT_GE(beta, 1.1 * dt * truth) << "a/b = " << ar;
+  }
+}
+
 // A dt RKC cannot take is a StepRejected (the driver reports it as unstable), and x is left as it was.
 TEST(Rkc, RefusesTooManyStagesWithStepRejected) {
   CapsuleFlow flow(make_case(1, 0.05, 2.0));

@@ -117,6 +117,10 @@ class CaseRun {
     } else {
       writer_.emplace(case_file_, case_attributes(config_));
     }
+    // A state that starts mirror-symmetric (every study case: the revolution axis in the shear plane) is
+    // kept exactly so after each step (mesh::symmetrise says why); a resumed run decides the same way from
+    // its checkpoint, which holds a symmetrised state.
+    keep_mirror_ = mesh::is_mirror_symmetric(mesh(), x_, 1e-12);
     before_ = x_;
     record_ = diagnostics::measure_step(mesh(), x_, t_, p_node_, 0.0);
     first_step_ = step_;
@@ -162,6 +166,7 @@ class CaseRun {
     bool stepped = false;
     try {
       info = integrator_->step(*flow_, next_, dt_, snapshot_due ? &start_ : nullptr);
+      if (keep_mirror_) mesh::symmetrise(mesh(), next_);
       stepped = true;
     } catch (const membrane::DegenerateSurface& e) {
       failure = e.what();
@@ -328,6 +333,7 @@ class CaseRun {
   long step_ = 0;
   diagnostics::TimeSeries series_;
   int p_node_ = 0;
+  bool keep_mirror_ = false;  // the state started mirror-symmetric: keep it exactly so (restore_or_start)
   diagnostics::WrinkleIndicators wrinkle_max_;  // largest sampled values over the run
 
   // The march.

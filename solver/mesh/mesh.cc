@@ -266,6 +266,32 @@ Eigen::Matrix3Xd node_normals(const SurfaceMesh& m, const Eigen::Matrix3Xd& x) {
   return n;
 }
 
+bool is_mirror_symmetric(const SurfaceMesh& m, const Eigen::Matrix3Xd& x, double tol) {
+  if (static_cast<int>(m.mirror_node.size()) != x.cols() || x.cols() == 0) return false;
+  const double scale = tol * (x.rowwise().maxCoeff() - x.rowwise().minCoeff()).norm();
+  for (int i = 0; i < x.cols(); ++i) {
+    const int j = m.mirror_node[i];
+    const double e = std::abs(x(0, i) - x(0, j)) + std::abs(x(1, i) - x(1, j)) + std::abs(x(2, i) + x(2, j));
+    if (!(e <= scale)) return false;
+  }
+  return true;
+}
+
+void symmetrise(const SurfaceMesh& m, Eigen::Matrix3Xd& x) {
+  for (int i = 0; i < x.cols(); ++i) {
+    const int j = m.mirror_node[i];
+    if (j == i) {
+      x(2, i) = 0.0;
+    } else if (i < j) {
+      const double a = 0.5 * (x(0, i) + x(0, j)), b = 0.5 * (x(1, i) + x(1, j)), c = 0.5 * (x(2, i) - x(2, j));
+      x(0, i) = x(0, j) = a;
+      x(1, i) = x(1, j) = b;
+      x(2, i) = c;
+      x(2, j) = -c;
+    }
+  }
+}
+
 SpheroidMap parse_spheroid_map(const std::string& name) {
   if (name == "conformal") return SpheroidMap::Conformal;
   if (name == "equal-arc-length") return SpheroidMap::EqualArcLength;

@@ -91,4 +91,16 @@ Eigen::Matrix3Xd node_normals(const SurfaceMesh& mesh, const Eigen::Matrix3Xd& x
 /// @throws std::invalid_argument naming the accepted values.
 SpheroidMap parse_spheroid_map(const std::string& name);
 
+/// @brief Whether x is mirror-symmetric under x3 → −x3 (mirror_node pairs) to `tol` relative to the extent
+/// of x; false if the mesh has no mirror map.
+bool is_mirror_symmetric(const SurfaceMesh& m, const Eigen::Matrix3Xd& x, double tol);
+
+/// @brief Makes x exactly mirror-symmetric: each pair (i, m) becomes the mean of x_i and the image of x_m
+/// (and its image), a node on the plane gets x3 = 0. Bitwise idempotent: an exactly symmetric x is unchanged.
+/// Why: a state that starts symmetric stays symmetric under the exact flow, but round-off (the CG's 1e-12
+/// residual in the load, sums in node order) makes the discrete state drift off it, and once the loads'
+/// asymmetry passes the boundary integral's 1e-10 test every evaluation costs the general scene's (twice
+/// the symmetric one's; results/benchmarks.md, "Whole cases, old build against new").
+void symmetrise(const SurfaceMesh& m, Eigen::Matrix3Xd& x);
+
 }  // namespace capsim::mesh

@@ -140,13 +140,7 @@ double membrane_spectral_radius(const mesh::SurfaceMesh& mesh, const Eigen::Matr
 
 double estimate_spectral_radius(CapsuleFlow& flow, const Eigen::Matrix3Xd& x, int iterations) {
   const auto& mirror = flow.mesh().mirror_node;
-  bool symmetric = !mirror.empty();
-  const double scale = x.cwiseAbs().maxCoeff();
-  for (int i = 0; symmetric && i < x.cols(); ++i) {
-    const int m = mirror[i];
-    symmetric = std::abs(x(0, i) - x(0, m)) <= 1e-12 * scale && std::abs(x(1, i) - x(1, m)) <= 1e-12 * scale &&
-                std::abs(x(2, i) + x(2, m)) <= 1e-12 * scale;
-  }
+  const bool symmetric = mesh::is_mirror_symmetric(flow.mesh(), x, 1e-12);
   auto symmetrise = [&](Eigen::Matrix3Xd& z) {
     if (!symmetric) return;
     Eigen::Matrix3Xd zs = z;

@@ -8,20 +8,23 @@
 
 namespace capsim::campaign {
 
-namespace {
-double quantise(double x, double tolerance) {
+double quantise_ca(double x, double tolerance) {
   // Round to a decimal quantum 10^-scale below tolerance/2, exactly (0.0275, not 0.027500000000000004).
   const int scale = std::max(0, static_cast<int>(-std::floor(std::log10(tolerance / 2))));
   return Decimal{static_cast<std::int64_t>(std::llround(x * std::pow(10.0, scale))), scale}.to_double();
 }
-}  // namespace
 
 std::vector<double> propose_refinement(const Transition& t, std::vector<Sample> samples, double tol,
                                        const std::vector<double>& existing) {
+  return propose_refinement(t, std::move(samples), tol, BracketTolerances{tol, tol, tol}, existing);
+}
+
+std::vector<double> propose_refinement(const Transition& t, std::vector<Sample> samples, double tol,
+                                       const BracketTolerances& per, const std::vector<double>& existing) {
   std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.ca < b.ca; });
   std::vector<double> out;
   auto add = [&](double x) {
-    x = quantise(x, tol);
+    x = quantise_ca(x, tol);
     if (!(x > 0)) return;
     auto same = [x](double y) { return std::fabs(y - x) < 1e-12 * std::max(1.0, x); };
     for (const auto& s : samples)
@@ -32,12 +35,12 @@ std::vector<double> propose_refinement(const Transition& t, std::vector<Sample> 
     out.push_back(x);
   };
   // Ca* edges: bisect between the last sample above the threshold and the first below it (both sides).
-  if (t.ca_star_low && t.ca_star_below && *t.ca_star_low - *t.ca_star_below > tol)
+  if (t.ca_star_low && t.ca_star_below && *t.ca_star_low - *t.ca_star_below > std::max(tol, per.ca_star_low))
     add(0.5 * (*t.ca_star_low + *t.ca_star_below));
-  if (t.ca_star_high && t.ca_star_above && *t.ca_star_above - *t.ca_star_high > tol)
+  if (t.ca_star_high && t.ca_star_above && *t.ca_star_above - *t.ca_star_high > std::max(tol, per.ca_star_high))
     add(0.5 * (*t.ca_star_high + *t.ca_star_above));
   // No sample below the threshold yet: bracket the minimum of min D12 more finely around the best sample.
-  if (!t.ca_star_low && t.ca_min_d12) {
+  if (!t.ca_star_low && t.ca_min_d12 && per.bracket_minimum) {
     auto it = std::find_if(samples.begin(), samples.end(), [&](const Sample& s) { return s.ca == *t.ca_min_d12; });
     if (it != samples.end()) {
       if (it != samples.begin() && it->ca - std::prev(it)->ca > tol) add(0.5 * (it->ca + std::prev(it)->ca));
@@ -45,7 +48,7 @@ std::vector<double> propose_refinement(const Transition& t, std::vector<Sample> 
     }
   }
   // CaH: false position clamped to the middle half of the bracket, so the bracket shrinks every round.
-  if (t.ca_h && t.ca_h_low && t.ca_h_high && *t.ca_h_high - *t.ca_h_low > tol) {
+  if (t.ca_h && t.ca_h_low && t.ca_h_high && *t.ca_h_high - *t.ca_h_low > std::max(tol, per.ca_h)) {
     const double lo = *t.ca_h_low, hi = *t.ca_h_high, w = hi - lo;
     add(std::clamp(*t.ca_h, lo + 0.25 * w, hi - 0.25 * w));
   }

@@ -137,7 +137,9 @@ std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases) {
     }
     SampleGroup& g = out[it->second];
     g.case_ca.push_back(c.params.capillary_number());
-    if (c.status == "done") g.samples.push_back({c.params.capillary_number(), c.min_d12, c.max_tau_min, c.case_id});
+    if (c.status == "done")
+      g.samples.push_back({c.params.capillary_number(), c.min_d12, c.max_tau_min, c.case_id, c.min_d12_spread,
+                           c.max_tau_min_spread, c.dt});
   }
   return out;
 }

@@ -33,6 +33,17 @@ struct Transition {
   std::string ca_h_low_case, ca_h_high_case;          ///< bracket case ids
   std::string method = "grid";         ///< grid | adaptive
   std::string note;                    ///< e.g. "CaH above sampled range"
+  /// @brief What the group is for in its cell (analysis/uncertainty.h): "answer" (Table 1 prints it),
+  /// "scan" (the coarse level of a multi-fidelity campaign), "mesh_check" (a finer level run at the
+  /// brackets only) or "dt_check" (a smaller time step at a bracketing case).
+  std::string role = "answer";
+  /// @brief Numerical uncertainty of each answer in Ca (analysis/uncertainty.h says how it is made);
+  /// nullopt where the answer is missing or nothing estimates it.
+  std::optional<double> ca_star_low_err, ca_star_high_err, ca_h_err;
+  /// @brief The largest part of each error: "mesh", "periods", "dt" or "bracket" (a Ca* edge's sampling).
+  std::string ca_star_low_err_source, ca_star_high_err_source, ca_h_err_source;
+  std::string error_levels;  ///< mesh levels whose values entered the mesh part, e.g. "2,3"
+  std::string error_note;    ///< provenance: every part of every error and how it was obtained
 };
 
 /// @brief One finished case of a group.
@@ -41,6 +52,9 @@ struct Sample {
   std::optional<double> min_d12;        ///< min D12 over the last period
   std::optional<double> max_tau_min;    ///< max over the period of the minimum principal tension
   std::string case_id;                  ///< identity
+  std::optional<double> min_d12_spread;      ///< min_D12_period_spread of its result (nullopt: not recorded)
+  std::optional<double> max_tau_min_spread;  ///< max_tau_min_period_spread of its result
+  std::optional<double> dt;                  ///< time step the case ran with
 };
 
 /// @brief One case of a campaign with its result, as the store reads it (the input of the grouping).
@@ -50,6 +64,7 @@ struct CaseSample {
   std::string status;                   ///< queued | running | done | unstable | failed
   std::optional<double> min_d12;        ///< from its result (done/unstable), else nullopt
   std::optional<double> max_tau_min;    ///< from its result, else nullopt
+  std::optional<double> min_d12_spread, max_tau_min_spread, dt;  ///< from its result (Sample says what)
 };
 
 /// @brief The cases of one group.

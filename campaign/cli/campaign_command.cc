@@ -27,19 +27,20 @@ using campaign::BadInput;
 // width (its error bound), no digit more (`capsim query sql` gives the stored values in full).
 campaign::Table transitions_table(const std::vector<campaign::Transition>& rows) {
   campaign::Table t;
-  t.columns = {"law", "aspect_ratio", "skalak_C", "mesh_level", "n_samples", "ca_star_low", "ca_star_high", "ca_h",
-               "ca_h_low", "ca_h_high", "method", "note"};
+  t.columns = {"law", "aspect_ratio", "skalak_C", "mesh_level", "role", "n_samples", "ca_star_low", "ca_star_high",
+               "ca_h", "ca_h_low", "ca_h_high", "method", "note"};
   auto sampled = [](const std::optional<double>& x) {
     return x ? campaign::SqlValue{campaign::format_sampled(*x)} : campaign::SqlValue{nullptr};
   };
   for (const auto& r : rows) {
     campaign::SqlValue h = nullptr;
     if (r.ca_h)
-      h = r.ca_h_low && r.ca_h_high ? campaign::format_with_error(*r.ca_h, *r.ca_h_high - *r.ca_h_low)
-                                    : campaign::format_significant(*r.ca_h, 3);
+      h = r.ca_h_err                  ? campaign::format_plus_minus(*r.ca_h, *r.ca_h_err)
+          : r.ca_h_low && r.ca_h_high ? campaign::format_with_error(*r.ca_h, *r.ca_h_high - *r.ca_h_low)
+                                      : campaign::format_significant(*r.ca_h, 3);
     t.rows.push_back({r.law, campaign::format_sampled(r.aspect_ratio),
                       r.skalak_C < 0 ? campaign::SqlValue{nullptr} : campaign::SqlValue{campaign::format_sampled(r.skalak_C)},
-                      std::int64_t{r.mesh_level}, std::int64_t{r.n_samples}, sampled(r.ca_star_low),
+                      std::int64_t{r.mesh_level}, r.role, std::int64_t{r.n_samples}, sampled(r.ca_star_low),
                       sampled(r.ca_star_high), h, sampled(r.ca_h_low), sampled(r.ca_h_high), r.method, r.note});
   }
   return t;
@@ -62,6 +63,14 @@ int status(const std::string& db_path, const std::string& name) {
       std::printf("  %-8s %s  %s a/b=%s Ca=%s  %s\n", p.status.c_str(), p.case_id.c_str(), p.law.c_str(),
                   campaign::canonical_double(p.aspect_ratio).c_str(), campaign::canonical_double(p.capillary_number).c_str(),
                   err.c_str());
+    }
+    // What each mesh level cost (a multi-fidelity campaign's saving is read here).
+    if (const auto costs = store->level_costs(c.campaign_id); costs.size() > 1) {
+      std::printf("  per mesh level:");
+      for (const auto& l : costs)
+        std::printf(" level %d: %d cases (%d finished, %s core-h);", l.mesh_level, l.cases, l.finished,
+                    campaign::format_significant(l.core_s / 3600.0, 3).c_str());
+      std::printf("\n");
     }
     if (auto tr = store->transitions(c.campaign_id); !tr.empty())
       std::printf("%s", campaign::render(transitions_table(tr), campaign::Format::kMarkdown).c_str());

@@ -48,6 +48,9 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
   // one cell of the table: say which keys differ instead of picking one.
   std::map<std::pair<std::string, double>, std::size_t> seen;
   for (auto& r : store.transitions(*store.find_campaign(camp), mesh_level, skalak_C)) {
+    // Scan, mesh-check and dt-check groups serve the answer's error; with --mesh-level the user asks for
+    // that level whatever its role.
+    if (r.role != "answer" && mesh_level < 0) continue;
     auto key = std::make_pair(r.law, r.aspect_ratio);
     if (auto it = seen.find(key); it != seen.end()) {
       const auto& first = rows[it->second];
@@ -69,15 +72,22 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
     throw BadInput("campaign '" + camp + "' has no transitions yet (run it first: capsim campaign run ...)");
   if (fmt != campaign::Format::kMarkdown) {
     campaign::Table t;
-    t.columns = {"law", "aspect_ratio", "ca_star_low", "ca_star_high", "ca_h"};
+    t.columns = {"law",          "aspect_ratio",     "ca_star_low", "ca_star_high", "ca_h",
+                 "ca_star_low_err", "ca_star_high_err", "ca_h_err",    "mesh_level",   "error_levels",
+                 "ca_star_low_err_source", "ca_star_high_err_source", "ca_h_err_source"};
+    auto text_or_null = [](const std::string& x) { return x.empty() ? SqlValue{nullptr} : SqlValue{x}; };
     for (const auto& r : rows)
-      t.rows.push_back({r.law, r.aspect_ratio, value_of(r.ca_star_low), value_of(r.ca_star_high), value_of(r.ca_h)});
+      t.rows.push_back({r.law, r.aspect_ratio, value_of(r.ca_star_low), value_of(r.ca_star_high), value_of(r.ca_h),
+                        value_of(r.ca_star_low_err), value_of(r.ca_star_high_err), value_of(r.ca_h_err),
+                        std::int64_t{r.mesh_level}, text_or_null(r.error_levels), text_or_null(r.ca_star_low_err_source),
+                        text_or_null(r.ca_star_high_err_source), text_or_null(r.ca_h_err_source)});
     std::printf("%s", campaign::render(t, fmt).c_str());
     return 0;
   }
-  // Markdown laid out like the seed's Table 1: one column per a/b, a Ca* line and a CaH line per law. The Ca*
-  // edges are sampled values (printed as sampled); CaH is interpolated in its bracket, whose width bounds its
-  // error: it is rounded to the leading digit of that width.
+  // Markdown laid out like the seed's Table 1: one column per a/b, a Ca* line and a CaH line per law. With an
+  // error estimate (analysis/uncertainty.h) an answer prints "x ± e", x to the digit of e. Without one, the
+  // Ca* edges are sampled values (printed as sampled) and CaH, interpolated in its bracket, is rounded to the
+  // leading digit of the bracket width (a lower bound of its error: the mesh error is not known).
   std::vector<double> ars;
   std::vector<std::pair<std::string, double>> laws;
   for (const auto& r : rows) {
@@ -102,11 +112,16 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
         h += " |";
         continue;
       }
-      star += r->ca_star_low && r->ca_star_high ? " Ca* ∈ [" + campaign::format_sampled(*r->ca_star_low) + ", " +
-                                                      campaign::format_sampled(*r->ca_star_high) + "] |"
+      // An edge with an error estimate prints "x ± e" (digits of the error); without one, as sampled.
+      auto edge = [](const std::optional<double>& x, const std::optional<double>& e) {
+        return e ? campaign::format_plus_minus(*x, *e) : campaign::format_sampled(*x);
+      };
+      star += r->ca_star_low && r->ca_star_high ? " Ca* ∈ [" + edge(r->ca_star_low, r->ca_star_low_err) + ", " +
+                                                      edge(r->ca_star_high, r->ca_star_high_err) + "] |"
                                                 : " Ca* not found |";
       h += r->ca_h && r->ca_h_low && r->ca_h_high
-               ? " CaH = " + campaign::format_with_error(*r->ca_h, *r->ca_h_high - *r->ca_h_low) + " |"
+               ? " CaH = " + (r->ca_h_err ? campaign::format_plus_minus(*r->ca_h, *r->ca_h_err)
+                                          : campaign::format_with_error(*r->ca_h, *r->ca_h_high - *r->ca_h_low)) + " |"
                : " CaH not bracketed |";
     }
     out += star + "\n" + h + "\n";

@@ -204,7 +204,8 @@ CampaignSpec parse_campaign(const std::string& text, const std::string& source) 
   if (auto* a = root.get("analysis")) {
     if (!a->is_table()) fail(source, "[analysis]", "expected a table");
     const auto& at = *a->as_table();
-    expect_only(at, {"D12_threshold", "adaptive", "ca_tolerance", "max_cases", "max_rounds"}, source, "[analysis]");
+    expect_only(at, {"D12_threshold", "adaptive", "ca_tolerance", "max_cases", "max_rounds", "levels", "dt_check"},
+                source, "[analysis]");
     auto number = [&](const char* k, double& out, double lo, double hi) {
       if (auto* n = at.get(k)) {
         std::optional<double> x = n->value_exact<double>();
@@ -234,6 +235,36 @@ CampaignSpec parse_campaign(const std::string& text, const std::string& source) 
       auto b = n->value_exact<bool>();
       if (!b) fail(source, "[analysis] adaptive", "expected true or false, got " + toml_type_name(*n));
       spec.analysis.adaptive = *b;
+    }
+    if (auto* n = at.get("levels")) {
+      const auto* arr = n->as_array();
+      if (!arr) fail(source, "[analysis] levels", "expected a list of 2 or 3 mesh levels, got " + toml_type_name(*n));
+      if (arr->size() < 2 || arr->size() > 3)
+        fail(source, "[analysis] levels", "expected 2 or 3 mesh levels ([scan, answer] or [scan, answer, check]), got " +
+                                              std::to_string(arr->size()));
+      for (const auto& e : *arr) {
+        auto x = e.value_exact<std::int64_t>();
+        if (!x) fail(source, "[analysis] levels", "expected integers, got " + toml_type_name(e));
+        if (*x < 0 || *x > 6) fail(source, "[analysis] levels", "mesh level out of range 0..6: " + std::to_string(*x));
+        if (!spec.analysis.levels.empty() && *x <= spec.analysis.levels.back())
+          fail(source, "[analysis] levels", "levels must increase (scan < answer < check)");
+        spec.analysis.levels.push_back(static_cast<int>(*x));
+      }
+      // The levels are the campaign's: a mesh level set elsewhere would contradict them.
+      if (root.at_path("defaults.mesh.level"))
+        fail(source, "[defaults] mesh.level", "not allowed with [analysis] levels (the scan level is levels[0])");
+      for (std::size_t b = 0; b < spec.grids.size(); ++b)
+        for (const auto& ax : spec.grids[b].axes)
+          if (ax.key == "mesh.level")
+            fail(source, "[grid][" + std::to_string(b + 1) + "] mesh_level", "not allowed with [analysis] levels");
+      spec.defaults.set("mesh.level", std::int64_t{spec.analysis.levels[0]});
+    }
+    if (auto* n = at.get("dt_check")) {
+      auto b = n->value_exact<bool>();
+      if (!b) fail(source, "[analysis] dt_check", "expected true or false, got " + toml_type_name(*n));
+      if (*b && spec.analysis.levels.empty())
+        fail(source, "[analysis] dt_check", "needs [analysis] levels (it re-runs a case of the answer level)");
+      spec.analysis.dt_check = *b;
     }
   }
   return spec;
@@ -265,6 +296,11 @@ std::string CampaignSpec::to_json() const {
   j["analysis"] = {{"D12_threshold", analysis.d12_threshold}, {"adaptive", analysis.adaptive},
                    {"ca_tolerance", analysis.ca_tolerance}, {"max_cases", analysis.max_cases},
                    {"max_rounds", analysis.max_rounds}};
+  // Only when set: the stored JSON of a campaign without them stays what it was.
+  if (!analysis.levels.empty()) {
+    j["analysis"]["levels"] = analysis.levels;
+    j["analysis"]["dt_check"] = analysis.dt_check;
+  }
   return j.dump();
 }
 

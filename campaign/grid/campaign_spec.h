@@ -28,6 +28,11 @@ struct AnalysisSpec {
   double ca_tolerance = 0.005;  ///< adaptive mode stops when brackets are narrower than this
   int max_cases = 200;          ///< adaptive mode never adds more than this many cases per campaign
   int max_rounds = 10;          ///< adaptive refinement rounds
+  /// @brief Multi-fidelity: [scan, answer] or [scan, answer, check] mesh levels (empty: off). The grid runs
+  /// on the scan level, the answer level starts from the scan's brackets (adaptive mode bisects there), the
+  /// check level re-runs the final brackets for the mesh error (campaign/README.md, "Multi-fidelity").
+  std::vector<int> levels;
+  bool dt_check = false;        ///< re-run one bracketing case per cell with dt/2 (the time-step error)
 };
 
 /// @brief A validated campaign.

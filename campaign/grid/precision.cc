@@ -32,4 +32,19 @@ std::string format_with_error(double x, double error) {
   return s;
 }
 
+std::string format_plus_minus(double x, double error) {
+  if (!(error > 0) || !std::isfinite(error) || !std::isfinite(x)) return format_significant(x, 3);
+  int e = static_cast<int>(std::floor(std::log10(error)));
+  double q = std::pow(10.0, e);
+  // Round the error up to one digit (with a little slack so that 0.05 stays 0.05 despite binary round-off).
+  double up = std::ceil(error / q * (1 - 1e-12)) * q;
+  if (up >= 10 * q * (1 - 1e-12)) {  // 0.096 -> 0.1: one digit, one place up
+    ++e;
+    q *= 10;
+    up = q;
+  }
+  const std::string err = format_with_error(up, q);
+  return format_with_error(x, q) + " ± " + err;
+}
+
 }  // namespace capsim::campaign

@@ -18,11 +18,14 @@
 #include <set>
 #include <thread>
 
+#include "campaign/analysis/multi_fidelity.h"
 #include "campaign/analysis/refinement.h"
+#include "campaign/analysis/uncertainty.h"
 #include "campaign/analysis/transitions.h"
 #include "campaign/common/bad_input.h"
 #include "campaign/grid/campaign_spec.h"
 #include "campaign/grid/decimal.h"
+#include "campaign/grid/precision.h"
 #include "campaign/scheduler/progress.h"
 #include "campaign/scheduler/worker_process.h"
 #include "campaign/store/store.h"
@@ -252,16 +255,39 @@ void recover(Store& store, const std::string& runs_dir, const std::function<void
 }  // namespace
 
 std::vector<Transition> analyse_campaign(Store& store, std::int64_t campaign_id, double d12_threshold,
-                                         const std::string& method) {
-  auto rows = analyse_groups(group_cases(store.campaign_samples(campaign_id)), d12_threshold, method);
+                                         const std::string& method, const std::vector<int>& levels) {
+  const auto groups = group_cases(store.campaign_samples(campaign_id));
+  auto rows = analyse_groups(groups, d12_threshold, method);
+  estimate_errors(rows, groups, ErrorOptions{levels});
   store.save_transitions(campaign_id, rows);
   return rows;
 }
 
-int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir) {
+int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir,
+                    std::string* what) {
   const int budget = spec.analysis.max_cases - store.count_campaign_cases(campaign_id, "adaptive");
-  const auto add = refinement_round(group_cases(store.campaign_samples(campaign_id)), spec.analysis.d12_threshold,
-                                    spec.analysis.ca_tolerance, budget);
+  const auto groups = group_cases(store.campaign_samples(campaign_id));
+  std::vector<CaseParams> add;
+  std::string phase = "adaptive refinement";
+  if (!spec.analysis.levels.empty()) {
+    // The phases of analysis/multi_fidelity.h, the first that has something to add.
+    const auto& lv = spec.analysis.levels;
+    const MultiFidelityOptions mf{lv, spec.analysis.d12_threshold, spec.analysis.ca_tolerance, spec.analysis.adaptive};
+    add = answer_level_round(groups, mf, budget);
+    phase = "multi-fidelity: level " + std::to_string(lv[1]) + " (seed, re-bracket" +
+            (spec.analysis.adaptive ? ", refine)" : ")");
+    if (add.empty() && lv.size() > 2) {
+      add = check_level_cases(groups, mf, budget);
+      phase = "multi-fidelity: mesh check on level " + std::to_string(lv[2]);
+    }
+    if (add.empty() && spec.analysis.dt_check) {
+      add = dt_check_cases(groups, mf, budget);
+      phase = "multi-fidelity: dt/2 check on level " + std::to_string(lv[1]);
+    }
+  } else {
+    add = refinement_round(groups, spec.analysis.d12_threshold, spec.analysis.ca_tolerance, budget);
+  }
+  if (what) *what = phase;
   if (add.empty()) return 0;
   Transaction t(store.db());
   const int added = store.add_cases(campaign_id, add, "adaptive", runs_dir);
@@ -388,18 +414,31 @@ int run_campaign(const RunOptions& opt, const BeforeRun& before_run) {
                  std::to_string(jobs) + " job(s) x " + std::to_string(threads) + " thread(s), database " + opt.db_path);
 
   bool completed = runner.run_queued();
-  const std::string method = spec.analysis.adaptive ? "adaptive" : "grid";
-  if (completed && spec.analysis.adaptive) {
-    for (int round = 1; round <= spec.analysis.max_rounds && completed; ++round) {
-      int added = refine_campaign(*store, campaign_id, spec, runs_dir);
+  const std::string method = !spec.analysis.levels.empty() ? "multi-fidelity" : spec.analysis.adaptive ? "adaptive" : "grid";
+  if (completed && (spec.analysis.adaptive || !spec.analysis.levels.empty())) {
+    // Multi-fidelity: max_rounds answer-level rounds, then the check level and the dt check (two more).
+    const int rounds = spec.analysis.max_rounds + (spec.analysis.levels.empty() ? 0 : 2);
+    for (int round = 1; round <= rounds && completed; ++round) {
+      std::string what;
+      int added = refine_campaign(*store, campaign_id, spec, runs_dir, &what);
       if (added == 0) break;
-      runner.message("capsim campaign: adaptive round " + std::to_string(round) + ": " + std::to_string(added) +
-                     " case(s) added");
+      runner.message(spec.analysis.levels.empty()
+                         ? "capsim campaign: adaptive round " + std::to_string(round) + ": " + std::to_string(added) +
+                               " case(s) added"
+                         : "capsim campaign: round " + std::to_string(round) + ", " + what + ": " +
+                               std::to_string(added) + " case(s) added");
       completed = runner.run_queued();
     }
   }
   runner.finish();
-  analyse_campaign(*store, campaign_id, spec.analysis.d12_threshold, method);
+  analyse_campaign(*store, campaign_id, spec.analysis.d12_threshold, method, spec.analysis.levels);
+  if (!spec.analysis.levels.empty()) {
+    std::string cost = "capsim campaign: cases per mesh level (finished / linked, core-hours):";
+    for (const auto& l : store->level_costs(campaign_id))
+      cost += " level " + std::to_string(l.mesh_level) + " " + std::to_string(l.finished) + "/" +
+              std::to_string(l.cases) + " (" + format_significant(l.core_s / 3600.0, 3) + " h);";
+    std::fprintf(stderr, "%s\n", cost.c_str());
+  }
   if (!completed) {
     std::fprintf(stderr, "capsim campaign: interrupted; the database is consistent. Rerun the same command to resume.\n");
     return kRunInterrupted;

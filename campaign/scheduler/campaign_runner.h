@@ -83,12 +83,16 @@ PreparedCampaign prepare_campaign(const RunOptions& opt, const std::function<voi
 std::string prepare_case_folder(const CaseRow& row, const std::string& runs_dir);
 
 /// @brief Recomputes the transitions of a campaign (analysis/ per group) and stores them; returns them.
+/// @p levels: the campaign's [analysis] levels (roles and errors, analysis/uncertainty.h).
 std::vector<Transition> analyse_campaign(Store& store, std::int64_t campaign_id, double d12_threshold,
-                                         const std::string& method);
+                                         const std::string& method, const std::vector<int>& levels = {});
 
 /// @brief One adaptive round (analysis/refinement.h) within the campaign's max_cases budget; returns how many
 /// cases it added to the campaign (0: nothing left to refine).
-int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir);
+/// With [analysis] levels, the next phase of analysis/multi_fidelity.h that adds cases (answer-level rounds,
+/// then the check level, then the dt check); @p what, if given, names the phase.
+int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir,
+                    std::string* what = nullptr);
 
 /// @brief Writes @p text to @p path via a temporary file in the same folder and rename (atomic).
 void write_file_atomic(const std::string& path, const std::string& text);

@@ -178,13 +178,18 @@ void reanalyse(Store& store, const std::set<std::int64_t>& campaigns) {
     if (!spec_json) continue;
     double threshold = 0.05;
     std::string method = "grid";
+    std::vector<int> levels;
     try {
       auto j = nlohmann::json::parse(*spec_json);
       threshold = j.at("analysis").at("D12_threshold").get<double>();
       if (j.at("analysis").value("adaptive", false)) method = "adaptive";
+      if (j.at("analysis").contains("levels")) {
+        levels = j.at("analysis").at("levels").get<std::vector<int>>();
+        method = "multi-fidelity";
+      }
     } catch (...) {
     }
-    analyse_campaign(store, id, threshold, method);
+    analyse_campaign(store, id, threshold, method, levels);
   }
 }
 
@@ -317,12 +322,13 @@ int submit_campaign(const SubmitOptions& opt) {
   CollectCounts n = collect_pass(store, std::nullopt, queue);
   reanalyse(store, n.changed_campaigns);
   if (n.changes()) log("capsim campaign submit: collected first: " + summary(n, queue));
-  if (spec.analysis.adaptive) {
-    // Adaptive mode: once the campaign has nothing queued, one refinement round per submit.
+  if (spec.analysis.adaptive || !spec.analysis.levels.empty()) {
+    // Adaptive or multi-fidelity mode: once the campaign has nothing queued, one round (phase) per submit.
     auto rows = store.campaign_cases(pc.campaign_id);
     if (std::none_of(rows.begin(), rows.end(), [](const CaseRow& r) { return r.status == "queued"; })) {
-      int added = refine_campaign(store, pc.campaign_id, spec, pc.runs_dir);
-      if (added) log("capsim campaign submit: adaptive refinement: " + std::to_string(added) + " case(s) added");
+      std::string what;
+      int added = refine_campaign(store, pc.campaign_id, spec, pc.runs_dir, &what);
+      if (added) log("capsim campaign submit: " + what + ": " + std::to_string(added) + " case(s) added");
     }
   }
   std::set<std::string> busy;

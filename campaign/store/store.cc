@@ -470,8 +470,10 @@ void Store::save_transitions(std::int64_t campaign_id, const std::vector<Transit
   d.step();
   Stmt s(*db_, std::string("INSERT INTO transitions(campaign_id,group_key,law,aspect_ratio,skalak_C,mesh_level,"
                            "d12_threshold,n_samples,ca_star_low,ca_star_high,ca_star_below,ca_star_above,ca_min_d12,"
-                           "ca_h,ca_h_low,ca_h_high,ca_h_low_case,ca_h_high_case,method,note,updated_at) "
-                           "VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,") + kNow + ")");
+                           "ca_h,ca_h_low,ca_h_high,ca_h_low_case,ca_h_high_case,method,note,role,ca_star_low_err,"
+                           "ca_star_high_err,ca_h_err,ca_star_low_err_source,ca_star_high_err_source,ca_h_err_source,"
+                           "error_levels,error_note,updated_at) "
+                           "VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,") + kNow + ")");
   auto opt_text = [](const std::string& x) { return x.empty() ? SqlValue{nullptr} : SqlValue{x}; };
   for (const auto& r : rows) {
     s.reset();
@@ -480,7 +482,10 @@ void Store::save_transitions(std::int64_t campaign_id, const std::vector<Transit
     s.bind_opt(9, r.ca_star_low).bind_opt(10, r.ca_star_high).bind_opt(11, r.ca_star_below);
     s.bind_opt(12, r.ca_star_above).bind_opt(13, r.ca_min_d12).bind_opt(14, r.ca_h).bind_opt(15, r.ca_h_low);
     s.bind_opt(16, r.ca_h_high).bind(17, opt_text(r.ca_h_low_case)).bind(18, opt_text(r.ca_h_high_case));
-    s.bind(19, r.method).bind(20, r.note);
+    s.bind(19, r.method).bind(20, r.note).bind(21, r.role).bind_opt(22, r.ca_star_low_err);
+    s.bind_opt(23, r.ca_star_high_err).bind_opt(24, r.ca_h_err).bind(25, opt_text(r.ca_star_low_err_source));
+    s.bind(26, opt_text(r.ca_star_high_err_source)).bind(27, opt_text(r.ca_h_err_source));
+    s.bind(28, opt_text(r.error_levels)).bind(29, r.error_note);
     s.step();
   }
   t.commit();
@@ -488,22 +493,31 @@ void Store::save_transitions(std::int64_t campaign_id, const std::vector<Transit
 
 std::vector<CaseSample> Store::campaign_samples(std::int64_t campaign_id) {
   Stmt s(*db_,
-         "SELECT c.case_id, c.params_json, c.status, r.min_D12, r.max_tau_min "
-         "FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id LEFT JOIN results r ON r.case_id=c.case_id "
+         "SELECT c.case_id, c.params_json, c.status, r.min_D12, r.max_tau_min, "
+         "json_extract(r.raw_json, '$.min_D12_period_spread'), json_extract(r.raw_json, '$.max_tau_min_period_spread'), "
+         "r.dt FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id LEFT JOIN results r ON r.case_id=c.case_id "
          "WHERE cc.campaign_id=? ORDER BY c.law, c.aspect_ratio, coalesce(c.skalak_C,-1), c.mesh_level, "
          "c.capillary_number");
   s.bind(1, campaign_id);
   std::vector<CaseSample> out;
-  while (s.step()) out.push_back({s.text(0), CaseParams::from_json(s.text(1)), s.text(2), s.real(3), s.real(4)});
+  while (s.step())
+    out.push_back({s.text(0), CaseParams::from_json(s.text(1)), s.text(2), s.real(3), s.real(4), s.real(5), s.real(6),
+                   s.real(7)});
   return out;
 }
 
 std::vector<Transition> Store::transitions(std::int64_t campaign_id, int mesh_level, double skalak_C) {
   const bool grouped = has_column(*db_, "transitions", "group_key");
+  const bool with_errors = has_column(*db_, "transitions", "role");  // schema 4
   Stmt s(*db_, std::string("SELECT ") + (grouped ? "group_key" : "''") +
                    ", law, aspect_ratio, skalak_C, mesh_level, d12_threshold, n_samples, ca_star_low, ca_star_high, "
                    "ca_star_below, ca_star_above, ca_min_d12, ca_h, ca_h_low, ca_h_high, coalesce(ca_h_low_case,''), "
-                   "coalesce(ca_h_high_case,''), method, note FROM transitions WHERE campaign_id=?1 "
+                   "coalesce(ca_h_high_case,''), method, note, " +
+                   (with_errors ? "role, ca_star_low_err, ca_star_high_err, ca_h_err, coalesce(ca_star_low_err_source,''), "
+                                  "coalesce(ca_star_high_err_source,''), coalesce(ca_h_err_source,''), "
+                                  "coalesce(error_levels,''), error_note"
+                                : "'answer', NULL, NULL, NULL, '', '', '', '', ''") +
+                   " FROM transitions WHERE campaign_id=?1 "
                    "AND (?2 < 0 OR mesh_level = ?2) AND (?3 < -0.5 OR skalak_C = ?3 OR law='neo-hookean') "
                    "ORDER BY law, aspect_ratio, mesh_level DESC, 1");
   s.bind(1, campaign_id).bind(2, std::int64_t{mesh_level}).bind(3, skalak_C);
@@ -529,6 +543,15 @@ std::vector<Transition> Store::transitions(std::int64_t campaign_id, int mesh_le
     t.ca_h_high_case = s.text(16);
     t.method = s.text(17);
     t.note = s.text(18);
+    t.role = s.text(19);
+    t.ca_star_low_err = s.real(20);
+    t.ca_star_high_err = s.real(21);
+    t.ca_h_err = s.real(22);
+    t.ca_star_low_err_source = s.text(23);
+    t.ca_star_high_err_source = s.text(24);
+    t.ca_h_err_source = s.text(25);
+    t.error_levels = s.text(26);
+    t.error_note = s.text(27);
     out.push_back(std::move(t));
   }
   return out;
@@ -603,6 +626,20 @@ int Store::count_campaign_cases(std::int64_t campaign_id, const std::string& ori
   s.bind(1, campaign_id).bind(2, origin);
   s.step();
   return static_cast<int>(s.integer(0));
+}
+
+std::vector<Store::LevelCost> Store::level_costs(std::int64_t campaign_id) {
+  Stmt s(*db_,
+         "SELECT c.mesh_level, count(*), count(r.case_id), "
+         "coalesce(sum(r.wall_s * coalesce(json_extract(r.raw_json, '$.threads'), 1)), 0) "
+         "FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id LEFT JOIN results r ON r.case_id=c.case_id "
+         "WHERE cc.campaign_id=? GROUP BY c.mesh_level ORDER BY c.mesh_level");
+  s.bind(1, campaign_id);
+  std::vector<LevelCost> out;
+  while (s.step())
+    out.push_back({static_cast<int>(s.integer(0)), static_cast<int>(s.integer(1)), static_cast<int>(s.integer(2)),
+                   s.real(3).value_or(0.0)});
+  return out;
 }
 
 }  // namespace capsim::campaign

@@ -85,7 +85,8 @@ class Store {
  public:
   /// @brief Opens for writing, creating the file and schema if needed (one transaction, before any
   /// worker). A database of an older schema version this build can migrate (1 -> 2: adds the Slurm
-  /// tables; 2 -> 3: transitions keyed by group) is migrated in one transaction; a newer or unknown version is refused.
+  /// tables; 2 -> 3: transitions keyed by group; 3 -> 4: role and error columns of transitions) is migrated in one
+  /// transaction; a newer or unknown version is refused.
   /// @throws BadInput for a corrupt/foreign file or a version it cannot read (nothing written).
   static std::unique_ptr<Store> open_for_write(const std::string& path);
   /// @brief Opens an existing database read-only (queries, status, dry runs). An older version that
@@ -149,6 +150,14 @@ class Store {
   Table cases_table(const CaseFilter& filter);
   /// @brief Number of cases linked to a campaign with origin @p origin ("grid" | "adaptive").
   int count_campaign_cases(std::int64_t campaign_id, const std::string& origin);
+  /// @brief Cases and cost of a campaign per mesh level (what a multi-fidelity campaign spent where).
+  struct LevelCost {
+    int mesh_level = 0;
+    int cases = 0;        ///< linked to the campaign, any status
+    int finished = 0;     ///< done or unstable
+    double core_s = 0;    ///< Σ wall_s × threads of the finished cases, as their workers reported
+  };
+  std::vector<LevelCost> level_costs(std::int64_t campaign_id);
 
  private:
   explicit Store(std::unique_ptr<Db> db) : db_(std::move(db)) {}

@@ -179,6 +179,18 @@ PeriodAnalysis analyse_periods(std::span<const double> t, std::span<const double
     res.min_tau_min = last.min_tau_min;
     res.mean_tau_min = last.mean_tau_min;
     res.tau_min_spread = last.max_tau_min - last.min_tau_min;
+    if (res.periods.size() >= 2) {
+      const std::size_t m = std::min<std::size_t>(res.periods.size(), PeriodAnalysis::kSpreadPeriods);
+      double d_lo = last.min_D12, d_hi = d_lo, t_lo = last.max_tau_min, t_hi = t_lo;
+      for (std::size_t k = 1; k < m; ++k) {
+        d_lo = std::min(d_lo, res.periods[k].min_D12);
+        d_hi = std::max(d_hi, res.periods[k].min_D12);
+        t_lo = std::min(t_lo, res.periods[k].max_tau_min);
+        t_hi = std::max(t_hi, res.periods[k].max_tau_min);
+      }
+      res.min_D12_period_spread = d_hi - d_lo;
+      res.max_tau_min_period_spread = t_hi - t_lo;
+    }
     return res;
   };
 
@@ -204,6 +216,16 @@ PeriodAnalysis analyse_periods(std::span<const double> t, std::span<const double
     finish(Regime::steady, {win});
     res.period = 0;
     res.revolution_period = 0;
+    // The period-to-period spread of a steady state: the same statistics on the two halves of the window.
+    const std::size_t mid = (w.i0 + n - 1) / 2;
+    if (mid > w.i0 && mid < n - 1) {
+      const auto d_a = *std::min_element(D12.begin() + w.i0, D12.begin() + mid + 1);
+      const auto d_b = *std::min_element(D12.begin() + mid, D12.end());
+      const auto t_a = *std::max_element(tau_min.begin() + w.i0, tau_min.begin() + mid + 1);
+      const auto t_b = *std::max_element(tau_min.begin() + mid, tau_min.end());
+      res.min_D12_period_spread = std::abs(d_a - d_b);
+      res.max_tau_min_period_spread = std::abs(t_a - t_b);
+    }
     return res;
   };
   const std::optional<Trailing> tail = trailing();

@@ -125,6 +125,13 @@ struct PeriodAnalysis {
   double theta_mean = kNaN, theta_amplitude = kNaN;
   double min_tau_min = kNaN, mean_tau_min = kNaN;  ///< statistics of τmin(t) over the same window
   double tau_min_spread = kNaN;                    ///< max_tau_min − min_tau_min
+  /// How much the answers move from period to period (the "periods" error of a Table 1 answer): max − min
+  /// of min D12 and of max τmin over the last kSpreadPeriods = 2 full periods (the two the stopping test
+  /// compares: an earlier one may still be in the start-up transient; NaN
+  /// with one). Steady: the difference between the two halves of the stationary window (the same
+  /// statistics taken on each half), i.e. how much the flicker moves them.
+  double min_D12_period_spread = kNaN, max_tau_min_period_spread = kNaN;
+  static constexpr int kSpreadPeriods = 2;
   /// Complete periods found, the most recent first. Tumbling: successive turns of θ by π back from the
   /// last sample. Swinging: between successive significant minima of D12. Steady: the one trailing window.
   std::vector<PeriodWindow> periods;

@@ -34,6 +34,8 @@ constexpr AnalysisField kAnalysisFields[] = {
     {"min_tau_min", &diagnostics::PeriodAnalysis::min_tau_min},
     {"mean_tau_min", &diagnostics::PeriodAnalysis::mean_tau_min},
     {"tau_min_spread", &diagnostics::PeriodAnalysis::tau_min_spread},
+    {"min_D12_period_spread", &diagnostics::PeriodAnalysis::min_D12_period_spread},
+    {"max_tau_min_period_spread", &diagnostics::PeriodAnalysis::max_tau_min_period_spread},
 };
 
 struct NumberField {

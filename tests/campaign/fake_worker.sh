@@ -7,6 +7,10 @@
 #   a/b < 1: min_D12 = 0.02 + 2.0 |Ca - 0.03|   (< 0.05 for |Ca - 0.03| < 0.015)
 #   a/b >= 1: min_D12 = 0.02 + 0.5 |Ca - 0.225| (< 0.05 for |Ca - 0.225| < 0.06)
 #   max_tau_min = CaH - Ca with CaH = 0.70 / 0.35 (neo-hookean, a/b 0.5 / 2) and 2.5 / 1.4 (skalak)
+# Discretisation errors with known limits, for the error estimates (campaign/analysis/uncertainty.h):
+#   FAKE_LEVEL_SHIFT=s: CaH of mesh level L is CaH - s 2^-L (first order in h, limit CaH);
+#   FAKE_DT_COEF=c: max_tau_min - c dt² (second order in dt; dt = time.dt of the case file, else 0.01,
+#   which is also the dt reported).
 # The JSON line is printed by `capsim _summary` (the case summary of the real worker): the capsim binary is
 # $FAKE_CAPSIM, else the capsim that started this worker (campaign run), else the one next to the test
 # executable that did (build/tests/X -> build/bin/capsim), else the source tree's build/bin/capsim, else
@@ -79,10 +83,13 @@ done
 trap '' TERM INT
 status=done
 in_list "$ca" "${FAKE_UNSTABLE_CA:-}" && status=unstable
-read -r d h <<< "$(awk -v ca="$ca" -v ar="$ar" -v law="$law" 'BEGIN {
+dt=$(get dt)
+[[ "$dt" =~ ^[0-9][0-9.e-]*$ ]] || dt=0.01
+read -r d h <<< "$(awk -v ca="$ca" -v ar="$ar" -v law="$law" -v L="$level" -v s="${FAKE_LEVEL_SHIFT:-0}" \
+                      -v c="${FAKE_DT_COEF:-0}" -v dt="$dt" 'BEGIN {
   if (ar < 1) { d = 0.02 + 2.0 * (ca > 0.03 ? ca - 0.03 : 0.03 - ca); h = (law == "skalak") ? 2.5 : 0.70 }
   else        { d = 0.02 + 0.5 * (ca > 0.225 ? ca - 0.225 : 0.225 - ca); h = (law == "skalak") ? 1.4 : 0.35 }
-  printf "%.17g %.17g\n", d, h - ca
+  printf "%.17g %.17g\n", d, h - s * 2 ^ (-L) - ca - c * dt * dt
 }')"
 regime=$(awk -v d="$d" 'BEGIN { print (d < 0.05 ? "swinging" : "tumbling") }')
 mean=$(awk -v d="$d" 'BEGIN { printf "%.17g", d + 0.1 }')
@@ -91,7 +98,7 @@ reason=""
 # The result line goes through the real summary code (capsim _summary), as `capsim run --json` prints it.
 "$capsim_bin" _summary status="$status" reason="$reason" capillary_number="$ca" aspect_ratio="$ar" law="$law" \
   skalak_C="$C" mesh_level="$level" min_D12="$d" max_tau_min="$h" mean_D12="$mean" period=12.5 regime="$regime" \
-  volume_drift=1e-4 steps=100 flow_evaluations=200 dt=0.01 t_final=25 wall_s=0.2 threads=1 case_file="$out/case.h5" \
+  volume_drift=1e-4 steps=100 flow_evaluations=200 dt="$dt" t_final=25 wall_s=0.2 threads=1 case_file="$out/case.h5" \
   code_version=fake || exit 1
 [ -n "${FAKE_LOG:-}" ] && echo "done $out" >> "$FAKE_LOG"
 exit 0

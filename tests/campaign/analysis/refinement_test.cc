@@ -22,7 +22,13 @@ CaseSample fake_case(double ca, const std::string& status, double dt = 0) {
     d12 = 0.02 + 0.5 * std::fabs(ca - 0.225);
     tau = 0.35 - ca;
   }
-  return {"id" + std::to_string(ca) + "-" + std::to_string(dt), p, status, d12, tau};
+  CaseSample c;
+  c.case_id = "id" + std::to_string(ca) + "-" + std::to_string(dt);
+  c.params = p;
+  c.status = status;
+  c.min_d12 = d12;
+  c.max_tau_min = tau;
+  return c;
 }
 
 TEST(Refinement, ExistingCasesAreNotProposedAgain) {

@@ -9,9 +9,18 @@
 namespace capsim::campaign {
 namespace {
 
+Sample sample(double ca, std::optional<double> d12, std::optional<double> tau, const std::string& id) {
+  Sample s;
+  s.ca = ca;
+  s.min_d12 = d12;
+  s.max_tau_min = tau;
+  s.case_id = id;
+  return s;
+}
+
 std::vector<Sample> samples(const std::vector<double>& cas, double (*d12)(double), double (*tau)(double)) {
   std::vector<Sample> out;
-  for (double ca : cas) out.push_back({ca, d12(ca), tau(ca), "id" + std::to_string(ca)});
+  for (double ca : cas) out.push_back(sample(ca, d12(ca), tau(ca), "id" + std::to_string(ca)));
   return out;
 }
 
@@ -37,7 +46,7 @@ TEST(Transitions, CaStarIsTheSampledIntervalBelowThreshold) {
 // The notes are printed (campaign status, the main command): numbers to 3 significant digits and sampled Ca as
 // sampled, never the 17 digits of a double (issue 12 §3).
 TEST(Transitions, NotesPrintNumbersToTheirPrecision) {
-  std::vector<Sample> s = {{0.4, 0.44971266940321575, 0.01, "a"}, {0.5, 0.49025674011763399, -0.01, "b"}};
+  std::vector<Sample> s = {sample(0.4, 0.44971266940321575, 0.01, "a"), sample(0.5, 0.49025674011763399, -0.01, "b")};
   const Transition t = analyse_group(Transition{}, s, 0.05);
   EXPECT_NE(t.note.find("smallest 0.45 at Ca=0.4"), std::string::npos) << t.note;
   EXPECT_EQ(t.note.find("0.4497"), std::string::npos) << t.note;

@@ -176,6 +176,35 @@ TEST(Grid, CasesTheSolverRejectsAreBadInput) {
   }
 }
 
+// [analysis] levels: the grid runs on the scan level; a mesh level given elsewhere contradicts it.
+TEST(Grid, MultiFidelityLevelsSetTheScanLevel) {
+  const std::string head = "[campaign]\nname='mf'\n[[grid]]\ncapillary_number=[0.1, 0.2]\n[analysis]\n";
+  const auto spec = parse_campaign(head + "levels = [2, 3, 4]\ndt_check = true\n", "mf.toml");
+  EXPECT_EQ(spec.analysis.levels, (std::vector<int>{2, 3, 4}));
+  EXPECT_TRUE(spec.analysis.dt_check);
+  for (const auto& p : expand_grid(spec)) EXPECT_EQ(p.mesh_level(), 2);
+  EXPECT_NE(spec.to_json().find("\"levels\":[2,3,4]"), std::string::npos) << spec.to_json();
+  // Without levels the stored JSON is what it was before they existed.
+  EXPECT_EQ(parse_campaign(head, "mf.toml").to_json().find("levels"), std::string::npos);
+  auto bad = [&](const std::string& text, const std::string& needle) {
+    try {
+      (void)parse_campaign(text, "mf.toml");
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const BadInput& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  bad(head + "levels = [3]\n", "2 or 3 mesh levels");
+  bad(head + "levels = [3, 2]\n", "must increase");
+  bad(head + "levels = [2, 9]\n", "out of range");
+  bad(head + "levels = [2, 3.5]\n", "integers");
+  bad(head + "dt_check = true\n", "needs [analysis] levels");
+  bad("[campaign]\nname='mf'\n[defaults]\nmesh.level = 3\n[[grid]]\ncapillary_number=[0.1]\n[analysis]\nlevels = [2, 3]\n",
+      "[defaults] mesh.level");
+  bad("[campaign]\nname='mf'\n[[grid]]\ncapillary_number=[0.1]\nmesh_level=[2]\n[analysis]\nlevels = [2, 3]\n",
+      "mesh_level");
+}
+
 TEST(Identity, JsonRoundTripKeepsIdentity) {
   CaseParams p = base();
   p.set("mesh.spheroid_map", std::string("equal-arc-length"));

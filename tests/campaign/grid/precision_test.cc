@@ -28,6 +28,16 @@ TEST(Precision, InterpolatedValueHasTheDigitsOfItsError) {
   EXPECT_EQ(format_with_error(0.35123456789012345, 0), "0.351");
 }
 
+TEST(Precision, PlusMinusRoundsTheErrorUpAndTheValueToItsDigit) {
+  EXPECT_EQ(format_plus_minus(0.6034, 0.047), "0.60 ± 0.05");
+  EXPECT_EQ(format_plus_minus(0.6034, 0.05), "0.60 ± 0.05");   // an exact digit is not rounded up
+  EXPECT_EQ(format_plus_minus(0.6034, 0.012), "0.60 ± 0.02");  // up, never below the estimate
+  EXPECT_EQ(format_plus_minus(2.4871, 0.096), "2.5 ± 0.1");    // 0.096 rounds up to one digit of 0.1
+  EXPECT_EQ(format_plus_minus(0.31234, 0.0031), "0.312 ± 0.004");
+  EXPECT_EQ(format_plus_minus(123.4, 20), "120 ± 20");
+  EXPECT_EQ(format_plus_minus(0.351, 0), "0.351");              // no usable error: the value alone
+}
+
 TEST(Precision, DiagnosticsHaveThreeSignificantDigits) {
   EXPECT_EQ(format_significant(0.044971266940321575), "0.045");
   EXPECT_EQ(format_significant(-0.0123456), "-0.0123");

@@ -27,8 +27,10 @@ TEST(Migration, Version2DatabaseMigratesToGroupKeysAndKeepsTable1) {
   // A writer (collect: no Slurm job, nothing to ingest) migrates.
   auto r = sh("env PATH=/usr/bin:/bin " + exe() + " campaign collect --db " + db);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(sql(db, "PRAGMA user_version"), "3\n");
+  EXPECT_EQ(sql(db, "PRAGMA user_version"), "4\n");
   EXPECT_EQ(sql(db, "SELECT value FROM meta WHERE key='migrated_from'"), "2\n");
+  // Version 4 adds the role and error columns in place: migrated rows answer, without errors yet.
+  EXPECT_EQ(sql(db, "SELECT count(*) FROM transitions WHERE role='answer' AND ca_h_err IS NULL"), rows_before);
   EXPECT_EQ(sql(db, "SELECT count(*) FROM transitions"), rows_before);
   // Every migrated row has a distinct group key naming its law, a/b and level.
   EXPECT_EQ(sql(db, "SELECT count(DISTINCT group_key) FROM transitions"), rows_before);

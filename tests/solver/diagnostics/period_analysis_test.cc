@@ -144,6 +144,29 @@ TEST(PeriodAnalysis, SwingingOscillatesAboutAMeanInclination) {
   EXPECT_TRUE(periodic_regime_converged(a));
 }
 
+// The period-to-period spread of the answers (the "periods" error of Table 1): zero for an exactly periodic
+// signal, the growth over one period for a signal whose swing grows linearly in time.
+TEST(PeriodAnalysis, PeriodSpreadIsTheChangeOfTheAnswersOverTheLastPeriods) {
+  const double T = 6.5, w = 2 * kPi / T, growth = 1e-4;  // amplitude of D12 and τmin grows by growth per unit time
+  auto signal = [&](double g) {
+    return sample(40.0, 0.005, [&, g](double t, double& d, double& th, double& tau) {
+      th = 0.3 + 0.15 * std::sin(w * t);
+      d = 0.3 - (0.08 + g * t) * std::cos(w * t);
+      tau = 0.05 + (0.02 + g * t) * std::sin(w * t);
+    });
+  };
+  const auto periodic = analyse(signal(0.0));
+  ASSERT_EQ(periodic.regime, Regime::swinging);
+  EXPECT_LT(periodic.min_D12_period_spread, 1e-6);
+  EXPECT_LT(periodic.max_tau_min_period_spread, 1e-6);
+  const auto growing = analyse(signal(growth));
+  ASSERT_EQ(growing.regime, Regime::swinging);
+  ASSERT_GE(growing.periods.size(), 3u);
+  // Minima and maxima one period apart differ by growth · T (the last two periods are compared).
+  EXPECT_NEAR(growing.min_D12_period_spread, growth * T, 0.05 * growth * T);
+  EXPECT_NEAR(growing.max_tau_min_period_spread, growth * T, 0.05 * growth * T);
+}
+
 TEST(PeriodAnalysis, SwingingNearTheTransitionWithAKinkedMinimumStaysSwinging) {
   // Near Ca*, D12 dips to ~0 with a V-shaped minimum and θ jumps quickly there; still no net rotation.
   const double T = 8.0, w = 2 * kPi / T;

@@ -1,0 +1,167 @@
+#include "campaign/analysis/multi_fidelity.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "campaign/analysis/refinement.h"
+
+namespace capsim::campaign {
+
+namespace {
+
+bool same_ca(double a, double b) { return std::fabs(a - b) <= 1e-12 * std::max(1.0, std::fabs(b)); }
+
+// The group of the same cell as `like` at `level` with role `role`, or nullptr.
+const SampleGroup* find_group(const std::vector<SampleGroup>& groups, const std::vector<std::string>& roles,
+                              const SampleGroup& like, int level, const std::string& role, std::size_t* index = nullptr) {
+  const std::string cell = cell_key(like.key.group_key);
+  for (std::size_t i = 0; i < groups.size(); ++i)
+    if (roles[i] == role && groups[i].key.mesh_level == level && cell_key(groups[i].key.group_key) == cell) {
+      if (index) *index = i;
+      return &groups[i];
+    }
+  return nullptr;
+}
+
+// Collects new capillary numbers for one target group: positive, not among `existing`, not twice.
+struct Proposals {
+  const std::vector<double>& existing;
+  std::vector<double> ca;
+  void add(std::optional<double> x) {
+    if (!x || !(*x > 0)) return;
+    auto same = [&](double y) { return same_ca(y, *x); };
+    if (std::any_of(existing.begin(), existing.end(), same) || std::any_of(ca.begin(), ca.end(), same)) return;
+    ca.push_back(*x);
+  }
+};
+
+// Appends the cases of `ca` (template `base`, at `level`) within the budget; false once it is spent.
+bool emit(const CaseParams& base, int level, const std::vector<double>& ca, std::vector<CaseParams>& out, int& budget) {
+  for (double x : ca) {
+    if (budget <= 0) return false;
+    CaseParams p = base;
+    p.set("mesh.level", std::int64_t{level});
+    p.set("flow.capillary_number", x);
+    out.push_back(std::move(p));
+    --budget;
+  }
+  return true;
+}
+
+std::vector<double> sampled_ca(const SampleGroup& g) {
+  std::vector<double> ca;
+  for (const auto& s : g.samples) ca.push_back(s.ca);
+  std::sort(ca.begin(), ca.end());
+  return ca;
+}
+
+}  // namespace
+
+std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,
+                                           int budget) {
+  std::vector<CaseParams> out;
+  if (o.levels.size() < 2) return out;
+  const auto roles = group_roles(groups, ErrorOptions{o.levels});
+  const int scan_level = o.levels[0], answer_level = o.levels[1];
+  static const std::vector<double> kNone;
+  for (std::size_t i = 0; i < groups.size(); ++i) {
+    if (roles[i] != "scan" || groups[i].key.mesh_level != scan_level) continue;
+    const SampleGroup& scan = groups[i];
+    std::size_t ia = 0;
+    const SampleGroup* answer = find_group(groups, roles, scan, answer_level, "answer", &ia);
+    Proposals p{answer ? answer->case_ca : kNone, {}};
+
+    // Seed: the scan's brackets.
+    const Transition ts = analyse_group(scan.key, scan.samples, o.d12_threshold);
+    for (const auto& x : {ts.ca_star_below, ts.ca_star_low, ts.ca_star_high, ts.ca_star_above, ts.ca_h_low, ts.ca_h_high})
+      p.add(x);
+    if (!ts.ca_star_low) p.add(ts.ca_min_d12);
+
+    if (answer && !answer->samples.empty()) {
+      const Transition ta = analyse_group(answer->key, answer->samples, o.d12_threshold);
+      // Re-bracket: the next scan Ca outwards (beyond the scan's range ×1.5 / ÷1.5, CaH only: Ca* edges at the
+      // end of the scan's range stay there, as the grid's author chose the range).
+      const std::vector<double> scan_ca = sampled_ca(scan);
+      auto above = [&](double x, bool beyond) -> std::optional<double> {
+        for (double c : scan_ca)
+          if (c > x && !same_ca(c, x)) return c;
+        return beyond ? std::optional<double>(quantise_ca(1.5 * x, o.ca_tolerance)) : std::nullopt;
+      };
+      auto below = [&](double x, bool beyond) -> std::optional<double> {
+        for (auto it = scan_ca.rbegin(); it != scan_ca.rend(); ++it)
+          if (*it < x && !same_ca(*it, x)) return *it;
+        return beyond ? std::optional<double>(quantise_ca(x / 1.5, o.ca_tolerance)) : std::nullopt;
+      };
+      if (ta.ca_h_low && !ta.ca_h_high) p.add(above(*ta.ca_h_low, true));
+      if (ta.ca_h_high && !ta.ca_h_low) p.add(below(*ta.ca_h_high, true));
+      if (ta.ca_star_low && !ta.ca_star_below) p.add(below(*ta.ca_star_low, false));
+      if (ta.ca_star_high && !ta.ca_star_above) p.add(above(*ta.ca_star_high, false));
+      // Refine: bisect, each bracket down to max(ca_tolerance, its numerical error).
+      if (o.adaptive) {
+        const GroupErrors e = answer_errors(ta, groups, roles, ia);
+        // The minimum of min D12 is searched only near the threshold (< 3×): a sphere's 0.45 has no band to find.
+        double best = 1e300;
+        for (const auto& s : answer->samples)
+          if (s.min_d12) best = std::min(best, *s.min_d12);
+        const BracketTolerances tol{e.ca_star_low.numerical.value_or(0), e.ca_star_high.numerical.value_or(0),
+                                    e.ca_h.numerical.value_or(0), best < 3 * o.d12_threshold};
+        for (double x : propose_refinement(ta, answer->samples, o.ca_tolerance, tol, answer->case_ca)) p.add(x);
+      }
+    }
+    if (!emit(answer ? answer->base : scan.base, answer_level, p.ca, out, budget)) break;
+  }
+  return out;
+}
+
+std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,
+                                          int budget) {
+  std::vector<CaseParams> out;
+  if (o.levels.size() < 3) return out;
+  const auto roles = group_roles(groups, ErrorOptions{o.levels});
+  static const std::vector<double> kNone;
+  for (std::size_t i = 0; i < groups.size(); ++i) {
+    if (roles[i] != "answer" || groups[i].key.mesh_level != o.levels[1]) continue;
+    const SampleGroup& answer = groups[i];
+    const SampleGroup* check = find_group(groups, roles, answer, o.levels[2], "mesh_check");
+    Proposals p{check ? check->case_ca : kNone, {}};
+    const Transition t = analyse_group(answer.key, answer.samples, o.d12_threshold);
+    for (const auto& x : {t.ca_star_below, t.ca_star_low, t.ca_star_high, t.ca_star_above, t.ca_h_low, t.ca_h_high})
+      p.add(x);
+    if (!emit(answer.base, o.levels[2], p.ca, out, budget)) break;
+  }
+  return out;
+}
+
+std::vector<CaseParams> dt_check_cases(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,
+                                       int budget) {
+  std::vector<CaseParams> out;
+  if (o.levels.size() < 2) return out;
+  const auto roles = group_roles(groups, ErrorOptions{o.levels});
+  for (std::size_t i = 0; i < groups.size() && budget > 0; ++i) {
+    if (roles[i] != "answer" || groups[i].key.mesh_level != o.levels[1]) continue;
+    const SampleGroup& answer = groups[i];
+    const Transition t = analyse_group(answer.key, answer.samples, o.d12_threshold);
+    const std::optional<double> ca = t.ca_h_low ? t.ca_h_low : t.ca_star_low;
+    if (!ca) continue;
+    const Sample* c = nullptr;
+    for (const auto& s : answer.samples)
+      if (same_ca(s.ca, *ca)) c = &s;
+    if (!c || !c->dt) continue;
+    bool exists = false;  // a dt_check case at this Ca in the cell already (any status)
+    const std::string cell = cell_key(answer.key.group_key);
+    for (std::size_t j = 0; j < groups.size(); ++j)
+      if (roles[j] == "dt_check" && groups[j].key.mesh_level == answer.key.mesh_level &&
+          cell_key(groups[j].key.group_key) == cell)
+        for (double x : groups[j].case_ca) exists = exists || same_ca(x, *ca);
+    if (exists) continue;
+    CaseParams p = answer.base;
+    p.set("flow.capillary_number", *ca);
+    p.set("time.dt", 0.5 * *c->dt);
+    out.push_back(std::move(p));
+    --budget;
+  }
+  return out;
+}
+
+}  // namespace capsim::campaign

@@ -1,0 +1,53 @@
+#pragma once
+/// @file
+/// @brief Multi-fidelity campaigns (issue 14 §2): which cases the answer and check levels need, from what the
+/// other levels found. Pure: the scheduler adds the returned cases and runs them (campaign_runner.cc).
+///
+/// The phases, for [analysis] levels = [scan, answer(, check)]:
+/// 1. the grid runs on the scan level (cheap; its brackets are where the answers are, roughly);
+/// 2. **seed**: each scan group's bracketing Ca — both samples of each Ca* edge, of the CaH bracket, and the
+///    sample of smallest min D12 while no Ca* was found — are run on the answer level;
+/// 3. **re-bracket**: where the answer level does not bracket an answer the scan level did (the oblate NH
+///    CaH is 0.23 on level 2 and 0.60 on level 3), the next scan Ca outwards is run on the answer level
+///    (beyond the scan's range: ×1.5 or ÷1.5), until the answer level brackets it;
+/// 4. **refine** (adaptive mode): bisection on the answer level (analysis/refinement.h), each bracket
+///    stopping once it is narrower than max(ca_tolerance, the answer's numerical error): refining a bracket
+///    below what the mesh resolves buys nothing; without a Ca* band the minimum of min D12 is bracketed only
+///    while it is within 3× the threshold (a band may lie between samples; a sphere's 0.45 has none);
+/// 5. **check** (a third level): the final bracketing cases of every answer re-run on the check level,
+///    which gives the mesh part of the error (analysis/uncertainty.h);
+/// 6. **dt check** (dt_check = true): the CaH-low case of each cell (else its Ca*-low case) on the answer
+///    level with time.dt = half the step it ran with.
+/// Phases 2–4 repeat as rounds until none adds a case; 5 and 6 run once, after them.
+
+#include <vector>
+
+#include "campaign/analysis/transitions.h"
+#include "campaign/analysis/uncertainty.h"
+#include "campaign/grid/case_params.h"
+
+namespace capsim::campaign {
+
+/// @brief The inputs of every phase.
+struct MultiFidelityOptions {
+  std::vector<int> levels;      ///< [scan, answer] or [scan, answer, check]
+  double d12_threshold = 0.05;
+  double ca_tolerance = 0.005;  ///< smallest bracket adaptive mode makes
+  bool adaptive = false;        ///< phase 4
+};
+
+/// @brief Phases 2–4: the cases of one round on the answer level (none: the answer level is done). New cases
+/// only (a Ca that exists in the answer group, whatever its status, is not proposed), at most @p budget.
+std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,
+                                           int budget);
+
+/// @brief Phase 5: the final brackets of the answer level on the check level (levels[2]; none without one).
+std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,
+                                          int budget);
+
+/// @brief Phase 6: per cell, the CaH-low case of the answer level (else its Ca*-low case) with time.dt set
+/// to half the step it ran with; none where such a case exists already.
+std::vector<CaseParams> dt_check_cases(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,
+                                       int budget);
+
+}  // namespace capsim::campaign

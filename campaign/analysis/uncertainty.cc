@@ -1,0 +1,354 @@
+#include "campaign/analysis/uncertainty.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "campaign/grid/precision.h"
+
+namespace capsim::campaign {
+
+namespace {
+
+// The two quantities the answers are made of.
+enum class Quantity { kMinD12, kMaxTauMin };
+
+std::optional<double> value(const Sample& s, Quantity q) { return q == Quantity::kMinD12 ? s.min_d12 : s.max_tau_min; }
+std::optional<double> spread(const Sample& s, Quantity q) {
+  return q == Quantity::kMinD12 ? s.min_d12_spread : s.max_tau_min_spread;
+}
+const char* name_of(Quantity q) { return q == Quantity::kMinD12 ? "min D12" : "max τmin"; }
+
+bool same_ca(double a, double b) { return std::fabs(a - b) <= 1e-12 * std::max(1.0, std::fabs(b)); }
+
+// The samples of a group that have q, sorted by Ca.
+std::vector<const Sample*> with_value(const SampleGroup& g, Quantity q) {
+  std::vector<const Sample*> out;
+  for (const auto& s : g.samples)
+    if (value(s, q)) out.push_back(&s);
+  std::sort(out.begin(), out.end(), [](const Sample* a, const Sample* b) { return a->ca < b->ca; });
+  return out;
+}
+
+std::string group_dt(const std::string& group_key) {
+  const auto j = nlohmann::json::parse(group_key, nullptr, false);
+  if (!j.is_object() || !j.contains("time.dt")) return "auto";
+  return j["time.dt"].is_string() ? j["time.dt"].get<std::string>() : j["time.dt"].dump();
+}
+
+std::string num(double x) { return format_significant(x, 2); }
+
+// One part of the error of q at a case, in units of q, with how it was obtained.
+struct Part {
+  std::optional<double> e;
+  std::string how;
+};
+
+// The cell of group `self`: the other groups by level (non dt_check) and the dt_check groups at its level.
+struct Cell {
+  std::map<int, const SampleGroup*> by_level;
+  std::vector<const SampleGroup*> dt_checks;
+};
+
+Cell cell_of(const std::vector<SampleGroup>& groups, const std::vector<std::string>& roles, std::size_t self) {
+  Cell c;
+  const std::string key = cell_key(groups[self].key.group_key);
+  for (std::size_t i = 0; i < groups.size(); ++i) {
+    if (cell_key(groups[i].key.group_key) != key) continue;
+    if (roles[i] == "dt_check") {
+      if (groups[i].key.mesh_level == groups[self].key.mesh_level) c.dt_checks.push_back(&groups[i]);
+    } else if (i == self || !c.by_level.count(groups[i].key.mesh_level)) {
+      c.by_level[groups[i].key.mesh_level] = &groups[i];
+    }
+  }
+  c.by_level[groups[self].key.mesh_level] = &groups[self];
+  return c;
+}
+
+// Which answer a mesh comparison is about.
+enum class Answer { kCaH, kCaStarLow, kCaStarHigh };
+
+// Where the line through (a, ya), (b, yb) crosses `target` (nullopt when flat).
+std::optional<double> crossing(double a, double ya, double b, double yb, double target) {
+  if (ya == yb || !std::isfinite(ya) || !std::isfinite(yb)) return std::nullopt;
+  return a + (b - a) * (target - ya) / (yb - ya);
+}
+
+// The answer of another level g2 near the bracket (a, b) of the answer level: the crossing of the line
+// through g2's values at a and b when g2 has both (a check level run at the brackets; extrapolated if they do
+// not straddle), else g2's own answer from its own bracket (a scan level sampled elsewhere).
+std::optional<double> level_answer(const SampleGroup& g2, Answer which, double a, double b, double thr) {
+  const Quantity q = which == Answer::kCaH ? Quantity::kMaxTauMin : Quantity::kMinD12;
+  const double target = which == Answer::kCaH ? 0.0 : thr;
+  std::optional<double> ya, yb;
+  for (const auto& s : g2.samples) {
+    if (same_ca(s.ca, a)) ya = value(s, q);
+    if (same_ca(s.ca, b)) yb = value(s, q);
+  }
+  if (ya && yb) return crossing(a, *ya, b, *yb, target);
+  const Transition t2 = analyse_group(g2.key, g2.samples, thr);
+  if (which == Answer::kCaH) return t2.ca_h;
+  const auto& in = which == Answer::kCaStarLow ? t2.ca_star_low : t2.ca_star_high;
+  const auto& out = which == Answer::kCaStarLow ? t2.ca_star_below : t2.ca_star_above;
+  if (!in || !out) return std::nullopt;
+  std::optional<double> y_in, y_out;
+  for (const auto& s : g2.samples) {
+    if (same_ca(s.ca, *in)) y_in = s.min_d12;
+    if (same_ca(s.ca, *out)) y_out = s.min_d12;
+  }
+  if (!y_in || !y_out) return std::nullopt;
+  return crossing(*in, *y_in, *out, *y_out, thr);
+}
+
+// The mesh part of an answer, directly in Ca: the answer level's own value `here` against the neighbouring
+// levels' answers (Richardson with three monotone levels, else the last difference).
+Part mesh_part(const Cell& cell, int level, Answer which, double a, double b, double here, double thr,
+               std::set<int>& levels_used) {
+  std::optional<double> coarse, fine;
+  if (auto it = cell.by_level.find(level - 1); it != cell.by_level.end())
+    coarse = level_answer(*it->second, which, a, b, thr);
+  if (auto it = cell.by_level.find(level + 1); it != cell.by_level.end())
+    fine = level_answer(*it->second, which, a, b, thr);
+  Part p;
+  if (coarse) levels_used.insert(level - 1);
+  if (fine) levels_used.insert(level + 1);
+  auto text = [](int l, double x) { return "level " + std::to_string(l) + ": " + format_significant(x, 4); };
+  if (coarse && fine) {
+    const double d1 = here - *coarse, d2 = *fine - here;
+    if (d1 != 0 && d2 * d1 > 0 && std::fabs(d2) < std::fabs(d1)) {
+      const double r = d2 / d1;
+      p.e = std::fabs(d2) / (1 - r);
+      p.how = "Richardson over levels " + std::to_string(level - 1) + "–" + std::to_string(level + 1) + " (" +
+              text(level - 1, *coarse) + ", " + text(level + 1, *fine) + ", observed order " + num(std::log2(1 / r)) +
+              ")";
+      return p;
+    }
+  }
+  if (fine) {
+    p.e = std::fabs(*fine - here);
+    p.how = "difference to level " + std::to_string(level + 1) + " (" + text(level + 1, *fine) + ")";
+  } else if (coarse) {
+    p.e = std::fabs(here - *coarse);
+    p.how = "difference to level " + std::to_string(level - 1) + " (" + text(level - 1, *coarse) + ")";
+  }
+  return p;
+}
+
+// The dt part of the cell: the largest |q(r dt) − q(dt)| / (1 − r²) over the dt_check cases at this level.
+Part dt_part(const Cell& cell, const SampleGroup& base, Quantity q) {
+  Part p;
+  for (const SampleGroup* g : cell.dt_checks)
+    for (const auto& s : g->samples) {
+      if (!value(s, q) || !s.dt) continue;
+      for (const auto& b : base.samples) {
+        if (!same_ca(b.ca, s.ca) || !value(b, q) || !b.dt || !(*s.dt < *b.dt)) continue;
+        const double r = *s.dt / *b.dt;
+        const double e = std::fabs(*value(s, q) - *value(b, q)) / (1 - r * r);
+        if (!p.e || e > *p.e) {
+          p.e = e;
+          p.how = "dt " + num(*b.dt) + " against " + num(*s.dt) + " at Ca " + format_sampled(s.ca);
+        }
+      }
+    }
+  return p;
+}
+
+// The periods and dt parts of the error of q at the bracketing cases `cases` (largest over them), in units
+// of q; the mesh part is added in Ca by the caller.
+struct Parts {
+  Part mesh, periods, dt;
+};
+
+Parts parts_at(const Cell& cell, const SampleGroup& g, const std::vector<const Sample*>& cases, Quantity q) {
+  Parts out;
+  for (const Sample* c : cases)
+    if (auto sp = spread(*c, q); sp && (!out.periods.e || *sp > *out.periods.e))
+      out.periods = {sp, "spread over the last periods at Ca " + format_sampled(c->ca)};
+  out.dt = dt_part(cell, g, q);
+  return out;
+}
+
+// Fills e's parts (periods and dt through |slope|, mesh already in Ca), numerical, source and how.
+void to_ca(const Parts& parts, double slope, Quantity q, AnswerError& e) {
+  std::string how;
+  auto pick = [&](const std::optional<double>& out, const char* name) {
+    if (out && (!e.numerical || *out > *e.numerical)) {
+      e.numerical = out;
+      e.source = name;
+    }
+  };
+  if (parts.mesh.e) {
+    e.mesh = parts.mesh.e;
+    how += "; mesh " + num(*e.mesh) + " (" + parts.mesh.how + ")";
+  } else {
+    how += "; mesh: no data";
+  }
+  pick(e.mesh, "mesh");
+  auto one = [&](const Part& p, const char* name, std::optional<double>& out) {
+    if (!p.e) {
+      how += std::string("; ") + name + ": no data";
+      return;
+    }
+    out = *p.e / std::fabs(slope);
+    how += std::string("; ") + name + " " + num(*out) + " (" + name_of(q) + " ± " + num(*p.e) + ", " + p.how + ")";
+    pick(out, name);
+  };
+  one(parts.periods, "periods", e.periods);
+  one(parts.dt, "dt", e.dt);
+  e.how += how;
+}
+
+// Secant of q between samples lo and hi of s, widened from [lo, hi] by moving the ends outwards (those
+// allowed) until it spans at least `span`.
+double secant(const std::vector<const Sample*>& s, std::size_t lo, std::size_t hi, double span, Quantity q,
+              bool widen_lo, bool widen_hi, std::string& where) {
+  while (s[hi]->ca - s[lo]->ca < span) {
+    bool moved = false;
+    if (widen_lo && lo > 0) --lo, moved = true;
+    if (s[hi]->ca - s[lo]->ca < span && widen_hi && hi + 1 < s.size()) ++hi, moved = true;
+    if (!moved) break;
+  }
+  where = "[" + format_sampled(s[lo]->ca) + ", " + format_sampled(s[hi]->ca) + "]";
+  return (*value(*s[hi], q) - *value(*s[lo], q)) / (s[hi]->ca - s[lo]->ca);
+}
+
+AnswerError ca_h_error(const Transition& t, const Cell& cell, const SampleGroup& g, std::set<int>& levels) {
+  AnswerError e;
+  if (!t.ca_h || !t.ca_h_low || !t.ca_h_high) return e;
+  const auto s = with_value(g, Quantity::kMaxTauMin);
+  std::size_t a = s.size();
+  for (std::size_t i = 0; i + 1 < s.size(); ++i)
+    if (same_ca(s[i]->ca, *t.ca_h_low) && same_ca(s[i + 1]->ca, *t.ca_h_high)) a = i;
+  if (a == s.size()) return e;
+  std::string where;
+  const double slope = secant(s, a, a + 1, 0.1 * std::fabs(*t.ca_h), Quantity::kMaxTauMin, true, true, where);
+  e.how = "slope of max τmin " + num(slope) + " over Ca " + where;
+  if (!(std::fabs(slope) > 0) || !std::isfinite(slope)) {
+    e.how += "; zero slope: the error cannot be converted to Ca";
+    return e;
+  }
+  Parts parts = parts_at(cell, g, {s[a], s[a + 1]}, Quantity::kMaxTauMin);
+  parts.mesh = mesh_part(cell, g.key.mesh_level, Answer::kCaH, s[a]->ca, s[a + 1]->ca, *t.ca_h, t.d12_threshold, levels);
+  to_ca(parts, slope, Quantity::kMaxTauMin, e);
+  e.total = e.numerical;
+  return e;
+}
+
+AnswerError edge_error(const std::optional<double>& inside, const std::optional<double>& outside, bool low,
+                       double thr, const Cell& cell, const SampleGroup& g, std::set<int>& levels) {
+  AnswerError e;
+  if (!inside) return e;
+  if (!outside) {
+    e.how = "the edge is the end of the sampled range: its error is unknown";
+    return e;
+  }
+  const auto s = with_value(g, Quantity::kMinD12);
+  std::size_t in = s.size(), out = s.size();
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (same_ca(s[i]->ca, *inside)) in = i;
+    if (same_ca(s[i]->ca, *outside)) out = i;
+  }
+  if (in == s.size() || out == s.size()) return e;
+  e.bracket = std::fabs(*inside - *outside);
+  e.how = "bracket " + num(e.bracket) + " (Ca " + format_sampled(*outside) + " outside)";
+  std::string where;
+  const double span = 0.1 * std::fabs(*inside);
+  const double slope = low ? secant(s, out, in, span, Quantity::kMinD12, true, false, where)
+                           : secant(s, in, out, span, Quantity::kMinD12, false, true, where);
+  e.how += "; slope of min D12 " + num(slope) + " over Ca " + where;
+  if (std::fabs(slope) > 0 && std::isfinite(slope)) {
+    // The level's own crossing of the threshold between the two samples: what the mesh part compares.
+    const auto here = crossing(s[in]->ca, *s[in]->min_d12, s[out]->ca, *s[out]->min_d12, thr);
+    Parts parts = parts_at(cell, g, {s[in], s[out]}, Quantity::kMinD12);
+    if (here)
+      parts.mesh = mesh_part(cell, g.key.mesh_level, low ? Answer::kCaStarLow : Answer::kCaStarHigh, s[in]->ca,
+                             s[out]->ca, *here, thr, levels);
+    to_ca(parts, slope, Quantity::kMinD12, e);
+  }
+  e.total = e.bracket + e.numerical.value_or(0.0);
+  e.source = e.numerical && *e.numerical > e.bracket ? e.source : "bracket";
+  return e;
+}
+
+}  // namespace
+
+std::string cell_key(const std::string& group_key) {
+  auto j = nlohmann::json::parse(group_key, nullptr, false);
+  if (!j.is_object()) return group_key;
+  j.erase("mesh.level");
+  j.erase("time.dt");
+  return j.dump();
+}
+
+std::vector<std::string> group_roles(const std::vector<SampleGroup>& groups, const ErrorOptions& options) {
+  std::vector<std::string> roles(groups.size(), "answer");
+  // dt_check: within a cell and level, the groups whose time.dt is not the base one (the dt with the most
+  // samples; ties to "auto", then to the larger step).
+  std::map<std::pair<std::string, int>, std::map<std::string, std::size_t>> samples_by_dt;
+  for (const auto& g : groups)
+    samples_by_dt[{cell_key(g.key.group_key), g.key.mesh_level}][group_dt(g.key.group_key)] += g.samples.size() + 1;
+  for (std::size_t i = 0; i < groups.size(); ++i) {
+    const auto& g = groups[i];
+    const auto& dts = samples_by_dt[{cell_key(g.key.group_key), g.key.mesh_level}];
+    auto better = [](const std::pair<const std::string, std::size_t>& a,
+                     const std::pair<const std::string, std::size_t>& b) {
+      if (a.second != b.second) return a.second < b.second;
+      if (a.first == "auto" || b.first == "auto") return b.first == "auto";
+      return std::stod(a.first) < std::stod(b.first);
+    };
+    const std::string base = std::max_element(dts.begin(), dts.end(), better)->first;
+    const int level = g.key.mesh_level;
+    // Only multi-fidelity campaigns make dt checks; elsewhere a time.dt axis is a study of its own.
+    if (!options.levels.empty() && group_dt(g.key.group_key) != base) roles[i] = "dt_check";
+    else if (options.levels.size() >= 2)
+      roles[i] = level == options.levels[1] ? "answer" : level < options.levels[1] ? "scan" : "mesh_check";
+  }
+  return roles;
+}
+
+GroupErrors answer_errors(const Transition& t, const std::vector<SampleGroup>& groups,
+                          const std::vector<std::string>& roles, std::size_t index) {
+  GroupErrors out;
+  const Cell cell = cell_of(groups, roles, index);
+  const SampleGroup& g = groups[index];
+  std::set<int> levels{g.key.mesh_level};
+  out.ca_h = ca_h_error(t, cell, g, levels);
+  out.ca_star_low = edge_error(t.ca_star_low, t.ca_star_below, true, t.d12_threshold, cell, g, levels);
+  out.ca_star_high = edge_error(t.ca_star_high, t.ca_star_above, false, t.d12_threshold, cell, g, levels);
+  for (int l : levels) {
+    if (!out.levels.empty()) out.levels += ',';
+    out.levels += std::to_string(l);
+  }
+  return out;
+}
+
+void estimate_errors(std::vector<Transition>& rows, const std::vector<SampleGroup>& groups,
+                     const ErrorOptions& options) {
+  const auto roles = group_roles(groups, options);
+  for (std::size_t i = 0; i < rows.size() && i < groups.size(); ++i) {
+    Transition& t = rows[i];
+    t.role = roles[i];
+    const GroupErrors e = answer_errors(t, groups, roles, i);
+    t.ca_h_err = e.ca_h.total;
+    t.ca_star_low_err = e.ca_star_low.total;
+    t.ca_star_high_err = e.ca_star_high.total;
+    t.ca_h_err_source = e.ca_h.total ? e.ca_h.source : "";
+    t.ca_star_low_err_source = e.ca_star_low.total ? e.ca_star_low.source : "";
+    t.ca_star_high_err_source = e.ca_star_high.total ? e.ca_star_high.source : "";
+    t.error_levels = e.levels;
+    t.error_note.clear();
+    auto add = [&](const char* name, const AnswerError& a) {
+      if (a.how.empty()) return;
+      t.error_note += (t.error_note.empty() ? "" : " | ") + std::string(name) +
+                      (a.total ? " ± " + num(*a.total) + " (" + a.source + ")" : " ± ?") + ": " + a.how;
+    };
+    add("CaH", e.ca_h);
+    add("Ca* low", e.ca_star_low);
+    add("Ca* high", e.ca_star_high);
+  }
+}
+
+}  // namespace capsim::campaign

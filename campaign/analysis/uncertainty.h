@@ -1,0 +1,90 @@
+#pragma once
+/// @file
+/// @brief The numerical uncertainty of every Table 1 answer (issue 14 §1): Ca* edges and CaH with an error
+/// in Ca, the source that dominates it, and how it was obtained. Pure computation on the grouped cases.
+///
+/// A *cell* is the set of groups that differ only in `mesh.level` and `time.dt` (one law, a/b, C and
+/// everything else): the same answer computed at several resolutions. Within a cell each group has a role —
+/// `answer` (its transition is the cell's answer), `scan` (the coarse level of a multi-fidelity campaign),
+/// `mesh_check` (a finer level run at the brackets only) or `dt_check` (the answer level re-run with a
+/// smaller fixed step at a bracketing case).
+///
+/// The error of an answer has three parts, each converted to Ca:
+/// - **mesh**, compared as answers (in Ca): the answer level's value A_L (CaH, or for a Ca* edge the
+///   threshold crossing of the line through its inside and outside samples) against the neighbouring levels'
+///   A_{L±1} — the crossing of the line through that level's values at the same two Ca when it has both (a
+///   check level run at the brackets; extrapolated if they do not straddle), else its own answer from its own
+///   bracket (a scan level sampled elsewhere; comparing answers, not values interpolated across a coarse
+///   grid, keeps the V of min D12 from posing as a mesh error). With both neighbours and monotone
+///   differences d₁ = A_L − A_{L−1}, d₂ = A_{L+1} − A_L (same sign, |d₂| < |d₁|): Richardson with the observed
+///   ratio r = d₂/d₁, e = |d₂| / (1 − r) (the distance from A_L to the extrapolated limit; observed order
+///   p = log₂(1/r) since each level halves h). Otherwise the difference to the finer level |d₂|, or, with
+///   only a coarser level, |d₁| — the coarse level's own error, an over-estimate of level L's when the mesh
+///   converges (it is what a two-level campaign can say).
+/// - **periods**: the spread of the quantity q (max τmin for CaH, min D12 for an edge) over the last periods
+///   of the two bracketing cases (min_D12_period_spread, max_tau_min_period_spread of their results), the
+///   larger of the two;
+/// - **dt**: a dt_check case at the same Ca and level with step r·dt: e = |q_{r dt} − q_dt| / (1 − r²)
+///   (the time integrator is second order). One such pair is enough for the cell: its error is used for
+///   every answer.
+/// Periods and dt are errors of q; they become errors in Ca through the slope of q against Ca on the
+/// answer level. The error of the answer is the largest part (named in the source):
+/// - **CaH** (zero of max τmin between Ca_a and Ca_b): e_Ca = max(mesh, periods/|s|, dt/|s|), s the secant of
+///   max τmin over the bracket widened outwards (one sample each side at a time) until it spans 10 % of CaH,
+///   so that a bracket refined far below the noise of τmin does not give a meaningless slope.
+/// - **a Ca* edge** (the sampled Ca inside the band, the neighbour outside it): the edge lies between the
+///   two samples, so it inherits the whole gap, plus the numerical part:
+///   e_Ca = |Ca_in − Ca_out| + max(mesh, periods/|s|, dt/|s|), s the secant of min D12 from the inside sample
+///   outwards (widened away from the band in the same way). Its source is "bracket" when the gap is the
+///   larger part.
+/// A part that has no data (no other level, periods not recorded, no dt_check) is left out and said so in
+/// the note; with no part at all a CaH error is unknown (nullopt) and a Ca* edge's error is its gap.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "campaign/analysis/transitions.h"
+
+namespace capsim::campaign {
+
+/// @brief The key of the cell of a group: its group_key without mesh.level and time.dt.
+std::string cell_key(const std::string& group_key);
+
+/// @brief How a campaign's levels are used ([analysis] levels): empty = every group is an answer group
+/// (table1 prints the finest level; a time.dt axis is a study of its own, its groups are not dt checks);
+/// [scan, answer] or [scan, answer, check]: roles by level, and within a level the groups whose time.dt is
+/// not the base one (the dt with the most samples) are dt checks.
+struct ErrorOptions {
+  std::vector<int> levels;
+};
+
+/// @brief One answer's error, split into its parts (in Ca; nullopt: no data for that part).
+struct AnswerError {
+  std::optional<double> total;                    ///< what is reported (nullopt: unknown)
+  std::optional<double> numerical;                ///< the largest of mesh, periods, dt, in Ca
+  double bracket = 0;                             ///< sampling part (Ca* edges: the gap to the outside sample)
+  std::optional<double> mesh, periods, dt;        ///< each part in Ca
+  std::string source;                             ///< "mesh" | "periods" | "dt" | "bracket" | ""
+  std::string how;                                ///< one line: the parts and how each was obtained
+};
+
+/// @brief The errors of the three answers of one group.
+struct GroupErrors {
+  AnswerError ca_star_low, ca_star_high, ca_h;
+  std::string levels;  ///< levels that entered the mesh part, e.g. "2,3"
+};
+
+/// @brief Role of every group (groups[i] -> result[i]) under @p options; see the file comment.
+std::vector<std::string> group_roles(const std::vector<SampleGroup>& groups, const ErrorOptions& options);
+
+/// @brief The errors of the answers of @p t (the transition of groups[index]) from the other groups of its
+/// cell (@p roles from group_roles).
+GroupErrors answer_errors(const Transition& t, const std::vector<SampleGroup>& groups,
+                          const std::vector<std::string>& roles, std::size_t index);
+
+/// @brief Sets role and the error fields of every row; rows[i] must be the transition of groups[i].
+void estimate_errors(std::vector<Transition>& rows, const std::vector<SampleGroup>& groups,
+                     const ErrorOptions& options);
+
+}  // namespace capsim::campaign

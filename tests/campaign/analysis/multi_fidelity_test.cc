@@ -1,0 +1,126 @@
+// The phases of a multi-fidelity campaign as pure functions of the grouped cases: what the answer level
+// needs from the scan, where it re-brackets, when refinement stops, what the check level and dt check run.
+#include "campaign/analysis/multi_fidelity.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+namespace capsim::campaign {
+namespace {
+
+CaseSample fake(int level, double ca, const std::function<double(double)>& tau, const std::string& status = "done",
+                double dt = 0) {
+  CaseParams p = CaseParams::defaults();
+  p.set("capsule.law", std::string("neo-hookean"));
+  p.set("capsule.aspect_ratio", 0.5);
+  p.set("mesh.level", std::int64_t{level});
+  p.set("flow.capillary_number", ca);
+  if (dt > 0) p.set("time.dt", dt);
+  CaseSample c;
+  c.case_id = "L";
+  c.case_id += std::to_string(level) + '-' + std::to_string(ca) + '-' + std::to_string(dt);
+  c.params = p;
+  c.status = status;
+  if (status == "done") {
+    c.min_d12 = 0.3;  // no Ca* band: only CaH matters here
+    c.max_tau_min = tau(ca);
+    c.dt = dt > 0 ? dt : 0.02;
+  }
+  return c;
+}
+
+std::vector<double> ca_at(const std::vector<CaseParams>& cases, int level) {
+  std::vector<double> out;
+  for (const auto& p : cases) {
+    EXPECT_EQ(p.mesh_level(), level);
+    out.push_back(p.capillary_number());
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+const MultiFidelityOptions kOptions{{2, 3}, 0.05, 0.005, true};
+
+// Level 2: CaH 0.23 (the oblate NH capsule's coarse value); level 3: CaH 0.60.
+double tau2(double ca) { return 0.23 - ca; }
+double tau3(double ca) { return 0.60 - ca; }
+
+TEST(MultiFidelity, TheAnswerLevelStartsFromTheScanBrackets) {
+  std::vector<CaseSample> cases;
+  for (double ca : {0.1, 0.2, 0.5, 1.0}) cases.push_back(fake(2, ca, tau2));
+  const auto add = answer_level_round(group_cases(cases), kOptions, 100);
+  // The scan's CaH bracket (0.2, 0.5), and the smallest min D12 (no Ca* band; every min D12 equal: the first).
+  EXPECT_EQ(ca_at(add, 3), (std::vector<double>{0.1, 0.2, 0.5}));
+}
+
+TEST(MultiFidelity, TheAnswerLevelReBracketsWhereTheScanWasWrong) {
+  std::vector<CaseSample> cases;
+  for (double ca : {0.1, 0.2, 0.5, 1.0}) cases.push_back(fake(2, ca, tau2));
+  for (double ca : {0.1, 0.2}) cases.push_back(fake(3, ca, tau3));  // both above 0 at level 3
+  cases.push_back(fake(3, 0.5, tau3, "queued"));                     // exists: not proposed again
+  auto add = answer_level_round(group_cases(cases), kOptions, 100);
+  EXPECT_TRUE(add.empty()) << "0.5 is queued: nothing is known yet beyond 0.2 on level 3";
+  cases.pop_back();
+  cases.push_back(fake(3, 0.5, tau3));
+  add = answer_level_round(group_cases(cases), kOptions, 100);
+  // CaH lies above 0.5 on level 3: the next scan Ca outwards.
+  EXPECT_EQ(ca_at(add, 3), (std::vector<double>{1.0}));
+  cases.push_back(fake(3, 1.0, tau3));
+  cases.push_back(fake(3, 1.5, tau3, "failed"));
+  // Bracketed now (0.5, 1.0): bisection (false position clamped to the middle half: 0.625).
+  add = answer_level_round(group_cases(cases), kOptions, 100);
+  EXPECT_EQ(ca_at(add, 3), (std::vector<double>{0.625}));
+}
+
+TEST(MultiFidelity, RefinementStopsAtTheNumericalError) {
+  // The level-2 and level-3 values differ by 0.37 in τ (slope −1): the CaH error is 0.37, so a bracket of
+  // width 0.1 is already narrower than what the mesh resolves; with a level 2 close to level 3 it is not.
+  for (double offset : {0.37, 0.001}) {
+    std::vector<CaseSample> cases;
+    auto t2 = [offset](double ca) { return 0.60 + offset - ca; };
+    for (double ca : {0.1, 0.2, 0.5, 1.0}) cases.push_back(fake(2, ca, t2));
+    for (double ca : {0.1, 0.2, 0.5, 0.55, 0.65, 1.0}) cases.push_back(fake(3, ca, tau3));
+    const auto add = answer_level_round(group_cases(cases), kOptions, 100);
+    if (offset > 0.1) {
+      EXPECT_TRUE(add.empty()) << "bracket 0.1 < error 0.37: refining it buys nothing";
+    } else {
+      ASSERT_EQ(add.size(), 1u);
+      EXPECT_GT(add[0].capillary_number(), 0.55);
+      EXPECT_LT(add[0].capillary_number(), 0.65);
+    }
+  }
+}
+
+TEST(MultiFidelity, TheCheckLevelRunsTheFinalBrackets) {
+  std::vector<CaseSample> cases;
+  for (double ca : {0.1, 0.2, 0.5, 1.0}) cases.push_back(fake(2, ca, tau2));
+  for (double ca : {0.1, 0.55, 0.65, 1.0}) cases.push_back(fake(3, ca, tau3));
+  MultiFidelityOptions o = kOptions;
+  EXPECT_TRUE(check_level_cases(group_cases(cases), o, 100).empty()) << "no check level";
+  o.levels = {2, 3, 4};
+  EXPECT_EQ(ca_at(check_level_cases(group_cases(cases), o, 100), 4), (std::vector<double>{0.55, 0.65}));
+  cases.push_back(fake(4, 0.55, tau3, "queued"));
+  EXPECT_EQ(ca_at(check_level_cases(group_cases(cases), o, 100), 4), (std::vector<double>{0.65}));
+  EXPECT_TRUE(check_level_cases(group_cases(cases), o, 0).empty()) << "no budget";
+}
+
+TEST(MultiFidelity, TheDtCheckHalvesTheStepOfTheCaHLowCase) {
+  std::vector<CaseSample> cases;
+  for (double ca : {0.1, 0.2, 0.5, 1.0}) cases.push_back(fake(2, ca, tau2));
+  for (double ca : {0.1, 0.2, 0.5, 0.55, 0.65, 1.0}) cases.push_back(fake(3, ca, tau3));
+  const auto add = dt_check_cases(group_cases(cases), kOptions, 100);
+  ASSERT_EQ(add.size(), 1u);
+  EXPECT_EQ(add[0].mesh_level(), 3);
+  EXPECT_DOUBLE_EQ(add[0].capillary_number(), 0.55);
+  EXPECT_NE(add[0].canonical().find("time.dt=0.01"), std::string::npos) << add[0].canonical();
+  cases.push_back(fake(3, 0.55, tau3, "done", 0.01));
+  EXPECT_TRUE(dt_check_cases(group_cases(cases), kOptions, 100).empty()) << "it exists";
+  // The dt_check case does not disturb the answer level's rounds (it is another group).
+  EXPECT_TRUE(answer_level_round(group_cases(cases), MultiFidelityOptions{{2, 3}, 0.05, 0.005, false}, 100).empty());
+}
+
+}  // namespace
+}  // namespace capsim::campaign

@@ -1,0 +1,223 @@
+// Error estimates of the Table 1 answers on synthetic samples whose discretisation errors are known exactly:
+// max τmin = CaH_L − Ca with CaH_L converging at a known rate, so the distance to the limit is known.
+#include "campaign/analysis/uncertainty.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+namespace capsim::campaign {
+namespace {
+
+struct Fake {
+  int level = 3;
+  double dt = 0;  // 0: automatic (time.dt unset)
+  std::vector<double> ca;
+  std::function<double(double)> tau = [](double) { return 0.0; };
+  std::function<double(double)> d12 = [](double) { return 0.3; };
+  double tau_spread = -1, d12_spread = -1;  // < 0: not recorded
+  double ran_dt = 0.02;                     // the step the case reports
+};
+
+void add(std::vector<CaseSample>& out, const Fake& f) {
+  for (double ca : f.ca) {
+    CaseParams p = CaseParams::defaults();
+    p.set("capsule.law", std::string("neo-hookean"));
+    p.set("capsule.aspect_ratio", 0.5);
+    p.set("mesh.level", std::int64_t{f.level});
+    p.set("flow.capillary_number", ca);
+    if (f.dt > 0) p.set("time.dt", f.dt);
+    CaseSample c;
+    c.case_id = "L";
+    c.case_id += std::to_string(f.level) + '-' + std::to_string(f.dt) + '-' + std::to_string(ca);
+    c.params = p;
+    c.status = "done";
+    c.min_d12 = f.d12(ca);
+    c.max_tau_min = f.tau(ca);
+    if (f.tau_spread >= 0) c.max_tau_min_spread = f.tau_spread;
+    if (f.d12_spread >= 0) c.min_d12_spread = f.d12_spread;
+    c.dt = f.dt > 0 ? f.dt : f.ran_dt;
+    out.push_back(c);
+  }
+}
+
+// CaH of level L: 0.5 + 0.08 · 2^-L (first order: each level halves the error), limit 0.5.
+double cah(int level) { return 0.5 + 0.08 * std::pow(2.0, -level); }
+std::function<double(double)> tau_of(int level) {
+  return [level](double ca) { return cah(level) - ca; };
+}
+
+struct Analysed {
+  std::vector<SampleGroup> groups;
+  std::vector<Transition> rows;
+  const Transition& at(int level, const std::string& role = "answer") const {
+    for (const auto& r : rows)
+      if (r.mesh_level == level && r.role == role) return r;
+    throw std::runtime_error("no row");
+  }
+};
+
+Analysed analyse(const std::vector<CaseSample>& cases, std::vector<int> levels = {}) {
+  Analysed a;
+  a.groups = group_cases(cases);
+  a.rows = analyse_groups(a.groups, 0.05, "grid");
+  estimate_errors(a.rows, a.groups, ErrorOptions{levels});
+  return a;
+}
+
+TEST(Uncertainty, CellKeyIgnoresMeshLevelAndTimeStep) {
+  std::vector<CaseSample> cases;
+  add(cases, {.level = 2, .ca = {0.1}});
+  add(cases, {.level = 3, .dt = 0.01, .ca = {0.1}});
+  const auto g = group_cases(cases);
+  ASSERT_EQ(g.size(), 2u);
+  EXPECT_NE(g[0].key.group_key, g[1].key.group_key);
+  EXPECT_EQ(cell_key(g[0].key.group_key), cell_key(g[1].key.group_key));
+}
+
+TEST(Uncertainty, RolesFollowTheLevelsAndTheTimeStep) {
+  std::vector<CaseSample> cases;
+  add(cases, {.level = 2, .ca = {0.1, 0.2, 0.3}});
+  add(cases, {.level = 3, .ca = {0.1, 0.2}});
+  add(cases, {.level = 3, .dt = 0.01, .ca = {0.1}});
+  add(cases, {.level = 4, .ca = {0.1}});
+  const auto g = group_cases(cases);
+  const auto roles = group_roles(g, ErrorOptions{{2, 3, 4}});
+  std::map<std::pair<int, bool>, std::string> by;
+  for (std::size_t i = 0; i < g.size(); ++i)
+    by[{g[i].key.mesh_level, g[i].key.group_key.find("\"time.dt\":0.01") != std::string::npos}] = roles[i];
+  EXPECT_EQ(by[std::make_pair(2, false)], "scan");
+  EXPECT_EQ(by[std::make_pair(3, false)], "answer");
+  EXPECT_EQ(by[std::make_pair(3, true)], "dt_check");
+  EXPECT_EQ(by[std::make_pair(4, false)], "mesh_check");
+  // Without levels every group answers (table1 prints the finest level; a time.dt axis is a study of its own).
+  for (const auto& role : group_roles(g, ErrorOptions{})) EXPECT_EQ(role, "answer");
+}
+
+TEST(Uncertainty, ThreeLevelsGiveTheDistanceToTheLimitByRichardson) {
+  std::vector<CaseSample> cases;
+  add(cases, {.level = 2, .ca = {0.4, 0.6}, .tau = tau_of(2)});  // interpolated at the level-3 brackets: exact (linear)
+  add(cases, {.level = 3, .ca = {0.4, 0.5, 0.52, 0.6}, .tau = tau_of(3)});
+  add(cases, {.level = 4, .ca = {0.5, 0.52}, .tau = tau_of(4)});
+  const auto a = analyse(cases, {2, 3, 4});
+  const Transition& t = a.at(3);
+  ASSERT_TRUE(t.ca_h);
+  EXPECT_NEAR(*t.ca_h, cah(3), 1e-12);
+  ASSERT_TRUE(t.ca_h_err);
+  // The error is the distance from the level-3 answer to the limit 0.5 (the slope of τ is −1).
+  EXPECT_NEAR(*t.ca_h_err, cah(3) - 0.5, 1e-12);
+  EXPECT_EQ(t.ca_h_err_source, "mesh");
+  EXPECT_EQ(t.error_levels, "2,3,4");
+  EXPECT_NE(t.error_note.find("observed order 1"), std::string::npos) << t.error_note;
+  EXPECT_EQ(a.at(2, "scan").role, "scan");
+  EXPECT_EQ(a.at(4, "mesh_check").role, "mesh_check");
+}
+
+TEST(Uncertainty, TwoLevelsGiveTheCoarseDifference) {
+  std::vector<CaseSample> cases;
+  add(cases, {.level = 2, .ca = {0.4, 0.6}, .tau = tau_of(2)});
+  add(cases, {.level = 3, .ca = {0.4, 0.5, 0.52, 0.6}, .tau = tau_of(3)});
+  const auto a = analyse(cases, {2, 3});
+  const Transition& t = a.at(3);
+  ASSERT_TRUE(t.ca_h_err);
+  EXPECT_NEAR(*t.ca_h_err, cah(2) - cah(3), 1e-12);  // an over-estimate of level 3's own error, by design
+  EXPECT_GE(*t.ca_h_err, *t.ca_h - 0.5);             // ... so the limit lies within the bar
+  EXPECT_NE(t.error_note.find("difference to level 2"), std::string::npos) << t.error_note;
+}
+
+TEST(Uncertainty, NonMonotoneDifferencesFallBackToTheLastDifference) {
+  std::vector<CaseSample> cases;
+  add(cases, {.level = 2, .ca = {0.4, 0.6}, .tau = [](double ca) { return 0.53 - ca; }});
+  add(cases, {.level = 3, .ca = {0.4, 0.5, 0.55, 0.6}, .tau = [](double ca) { return 0.52 - ca; }});
+  add(cases, {.level = 4, .ca = {0.5, 0.55}, .tau = [](double ca) { return 0.525 - ca; }});  // turns back
+  const auto a = analyse(cases, {2, 3, 4});
+  ASSERT_TRUE(a.at(3).ca_h_err);
+  EXPECT_NEAR(*a.at(3).ca_h_err, 0.005, 1e-12);
+  EXPECT_NE(a.at(3).error_note.find("difference to level 4"), std::string::npos) << a.at(3).error_note;
+}
+
+TEST(Uncertainty, TheLargestPartIsCarriedAndNamed) {
+  std::vector<CaseSample> cases;
+  // Periods: max τmin moves by 0.03 between periods; mesh difference 0.01; slope 2 → 0.015 in Ca.
+  add(cases, {.level = 2, .ca = {0.4, 0.6}, .tau = [](double ca) { return 2 * (0.505 - ca); }});
+  add(cases, {.level = 3, .ca = {0.4, 0.5, 0.52, 0.6}, .tau = [](double ca) { return 2 * (0.5 - ca); },
+              .tau_spread = 0.03});
+  const auto a = analyse(cases, {2, 3});
+  const Transition& t = a.at(3);
+  ASSERT_TRUE(t.ca_h_err);
+  EXPECT_NEAR(*t.ca_h_err, 0.015, 1e-12);
+  EXPECT_EQ(t.ca_h_err_source, "periods");
+}
+
+TEST(Uncertainty, HalfTheStepGivesTheSecondOrderTimeError) {
+  // τ = 0.5 − Ca − 100 dt²: at dt 0.02 the time error is 0.04 in τ, 0.04 in Ca.
+  auto tau_dt = [](double dt) { return [dt](double ca) { return 0.5 - ca - 100 * dt * dt; }; };
+  std::vector<CaseSample> cases;
+  add(cases, {.level = 3, .ca = {0.4, 0.45, 0.5}, .tau = tau_dt(0.02)});
+  add(cases, {.level = 3, .dt = 0.01, .ca = {0.45}, .tau = tau_dt(0.01)});
+  const auto a = analyse(cases, {2, 3});
+  const Transition& t = a.at(3);
+  ASSERT_TRUE(t.ca_h_err);
+  EXPECT_NEAR(*t.ca_h_err, 100 * 0.02 * 0.02, 1e-12);
+  EXPECT_EQ(t.ca_h_err_source, "dt");
+  EXPECT_EQ(a.at(3, "dt_check").role, "dt_check");
+}
+
+TEST(Uncertainty, CaStarEdgeInheritsItsGapAndTheThresholdError) {
+  // min D12 = 0.02 + 0.5 |Ca − 0.225| on level 3 (band (0.165, 0.285)); level 2 is `shift` higher.
+  auto d12 = [](double shift) { return [shift](double ca) { return 0.02 + 0.5 * std::fabs(ca - 0.225) + shift; }; };
+  const std::vector<double> ca{0.1, 0.15, 0.2, 0.25, 0.3, 0.35};
+  for (double shift : {0.0, 0.01, 0.04}) {
+    std::vector<CaseSample> cases;
+    add(cases, {.level = 2, .ca = ca, .d12 = d12(shift)});
+    add(cases, {.level = 3, .ca = ca, .d12 = d12(0)});
+    const auto a = analyse(cases, {2, 3});
+    const Transition& t = a.at(3);
+    ASSERT_TRUE(t.ca_star_low && t.ca_star_low_err) << shift;
+    EXPECT_DOUBLE_EQ(*t.ca_star_low, 0.2);
+    EXPECT_DOUBLE_EQ(*t.ca_star_high, 0.25);
+    // gap 0.05 to the outside sample, plus shift / |slope 0.5|.
+    EXPECT_NEAR(*t.ca_star_low_err, 0.05 + shift / 0.5, 1e-12) << shift;
+    EXPECT_NEAR(*t.ca_star_high_err, 0.05 + shift / 0.5, 1e-12) << shift;
+    EXPECT_EQ(t.ca_star_low_err_source, shift / 0.5 > 0.05 ? "mesh" : "bracket") << shift;
+  }
+}
+
+TEST(Uncertainty, ANarrowBracketTakesItsSlopeFromAWiderSpan) {
+  // The bracket (0.5, 0.501) straddles the zero of τ = 0.5005 − Ca with ±0.0004 of noise on its two cases:
+  // their secant is −0.2, the true slope −1. The widened secant (span ≥ 10 % of CaH) gives ≈ −1, so a
+  // periods spread of 0.01 in τ is ≈ 0.01 in Ca, not 0.05.
+  std::vector<CaseSample> cases;
+  add(cases, {.level = 3,
+              .ca = {0.4, 0.45, 0.5, 0.501, 0.55, 0.6},
+              .tau = [](double ca) {
+                const double noise = ca == 0.5 ? -0.0004 : ca == 0.501 ? 0.0004 : 0.0;
+                return 0.5005 - ca + noise;
+              },
+              .tau_spread = 0.01});
+  const auto a = analyse(cases);
+  const Transition& t = a.at(3);
+  ASSERT_TRUE(t.ca_h_low && t.ca_h_err);
+  EXPECT_DOUBLE_EQ(*t.ca_h_low, 0.5);
+  EXPECT_NEAR(*t.ca_h_err, 0.01, 0.0015);
+}
+
+TEST(Uncertainty, WithoutAnyPartTheCaHErrorIsUnknownAndAnEdgeKeepsItsGap) {
+  std::vector<CaseSample> cases;
+  add(cases, {.level = 3,
+              .ca = {0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.6},
+              .tau = [](double ca) { return 0.45 - ca; },
+              .d12 = [](double ca) { return 0.02 + 0.5 * std::fabs(ca - 0.225); }});
+  const auto a = analyse(cases);
+  const Transition& t = a.at(3);
+  EXPECT_TRUE(t.ca_h);
+  EXPECT_FALSE(t.ca_h_err);
+  ASSERT_TRUE(t.ca_star_low_err);
+  EXPECT_NEAR(*t.ca_star_low_err, 0.05, 1e-12);
+  EXPECT_EQ(t.ca_star_low_err_source, "bracket");
+  EXPECT_NE(t.error_note.find("mesh: no data"), std::string::npos) << t.error_note;
+}
+
+}  // namespace
+}  // namespace capsim::campaign

@@ -1,0 +1,87 @@
+// A multi-fidelity campaign end to end (fake worker whose CaH converges at first order in h with a known
+// limit): scan on level 1, answer on level 2, check on level 3, dt/2 check; the answer's error bar is the
+// distance to the limit, and it is what `capsim query table1` reports.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "tests/campaign/test_util.h"
+
+namespace capsim::campaign::testing {
+namespace {
+
+TEST(MultiFidelity, ScanAnswerCheckAndTheErrorBarOfCaH) {
+  const std::string dir = fresh_dir("multi_fidelity");
+  const std::string db = dir + "/study.db";
+  write_file(dir + "/mf.toml", R"([campaign]
+name = "mf"
+[[grid]]
+aspect_ratio = [0.5]
+law = ["neo-hookean"]
+capillary_number = [0.01, 0.02, 0.03, 0.04, 0.05, 0.1, 0.4, 0.8, 1.2]
+[analysis]
+levels = [1, 2, 3]
+dt_check = true
+adaptive = true
+ca_tolerance = 0.005
+max_rounds = 20
+)");
+  // CaH of level L = 0.70 − 0.8 · 2^-L − 10 dt²: 0.30 / 0.50 / 0.60 on levels 1 / 2 / 3 (dt 0.01), limit 0.699.
+  const std::string env = "FAKE_STEPS=1 FAKE_STEP_S=0.001 FAKE_LEVEL_SHIFT=0.8 FAKE_DT_COEF=10";
+  auto r = sh(campaign_cmd(env, dir + "/mf.toml", db, "--jobs 2"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("multi-fidelity: level 2"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("mesh check on level 3"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("dt/2 check on level 2"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("cases per mesh level"), std::string::npos) << r.err;
+
+  auto rows = nlohmann::json::parse(
+      sh(exe() + " query sql \"SELECT mesh_level, role, method, ca_h, ca_h_low, ca_h_high, ca_h_err, ca_h_err_source, "
+                 "error_levels, error_note FROM transitions ORDER BY mesh_level, role\" --db " + db + " --format json")
+          .out);
+  ASSERT_EQ(rows.size(), 4u) << rows.dump(1);
+  EXPECT_EQ(rows[0]["role"], "scan");
+  EXPECT_EQ(rows[1]["role"], "answer");
+  EXPECT_EQ(rows[2]["role"], "dt_check");
+  EXPECT_EQ(rows[3]["role"], "mesh_check");
+  const auto& answer = rows[1];
+  EXPECT_EQ(answer["method"], "multi-fidelity");
+  EXPECT_EQ(answer["mesh_level"], 2);
+  // The answer level re-bracketed (the scan's bracket (0.1, 0.4) holds 0.30, not 0.50) and refined only to
+  // the error: the bracket is narrower than the first one but not below what the mesh resolves.
+  const double lo = answer["ca_h_low"], hi = answer["ca_h_high"], cah = answer["ca_h"], err = answer["ca_h_err"];
+  EXPECT_NEAR(cah, 0.70 - 0.2 - 0.001, 1e-9);
+  EXPECT_LE(lo, cah);
+  EXPECT_GE(hi, cah);
+  EXPECT_GT(hi - lo, 0.005) << "refined below the numerical error";
+  // Richardson over levels 1–3 gives exactly the distance to the limit (first order, ratio 1/2).
+  EXPECT_NEAR(err, 0.2, 1e-9) << answer["error_note"];
+  EXPECT_EQ(answer["ca_h_err_source"], "mesh");
+  EXPECT_EQ(answer["error_levels"], "1,2,3");
+  EXPECT_LE(std::fabs(0.699 - cah), err + 1e-9);
+  EXPECT_NE(answer["error_note"].get<std::string>().find("dt 0.001"), std::string::npos) << answer["error_note"];
+
+  // The query reports the answer level with its errors (the other roles serve the error only).
+  auto q = sh(exe() + " query table1 --db " + db + " --format json");
+  ASSERT_EQ(q.code, 0) << q.err;
+  auto t = nlohmann::json::parse(q.out);
+  ASSERT_EQ(t.size(), 1u);
+  EXPECT_EQ(t[0]["mesh_level"], 2);
+  EXPECT_NEAR(t[0]["ca_h_err"].get<double>(), 0.2, 1e-9);
+  EXPECT_EQ(t[0]["error_levels"], "1,2,3");
+  EXPECT_TRUE(t[0]["ca_star_low_err"].is_number()) << t[0].dump();
+  auto md = sh(exe() + " query table1 --db " + db + " --format md");
+  EXPECT_NE(md.out.find("CaH = 0.5 ± 0.2"), std::string::npos) << md.out;
+  auto csv = sh(exe() + " query table1 --db " + db + " --format csv");
+  EXPECT_NE(csv.out.find("ca_h_err"), std::string::npos) << csv.out;
+
+  // Resumable and idempotent: a second run adds nothing.
+  const auto before = sh(exe() + " query sql \"SELECT count(*) AS n FROM cases\" --db " + db + " --format json").out;
+  r = sh(campaign_cmd(env, dir + "/mf.toml", db, "--jobs 2"));
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(sh(exe() + " query sql \"SELECT count(*) AS n FROM cases\" --db " + db + " --format json").out, before);
+}
+
+}  // namespace
+}  // namespace capsim::campaign::testing

@@ -49,6 +49,11 @@ bool emit(const CaseParams& base, int level, const std::vector<double>& ca, std:
   return true;
 }
 
+// The samples an answer rests on: both sides of each Ca* edge and of the CaH bracket.
+std::vector<std::optional<double>> bracketing_ca(const Transition& t) {
+  return {t.ca_star_below, t.ca_star_low, t.ca_star_high, t.ca_star_above, t.ca_h_low, t.ca_h_high};
+}
+
 std::vector<double> sampled_ca(const SampleGroup& g) {
   std::vector<double> ca;
   for (const auto& s : g.samples) ca.push_back(s.ca);
@@ -74,8 +79,7 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
 
     // Seed: the scan's brackets.
     const Transition ts = analyse_group(scan.key, scan.samples, o.d12_threshold);
-    for (const auto& x : {ts.ca_star_below, ts.ca_star_low, ts.ca_star_high, ts.ca_star_above, ts.ca_h_low, ts.ca_h_high})
-      p.add(x);
+    for (const auto& x : bracketing_ca(ts)) p.add(x);
     if (!ts.ca_star_low) p.add(ts.ca_min_d12);
 
     if (answer && !answer->samples.empty()) {
@@ -126,8 +130,7 @@ std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups
     const SampleGroup* check = find_group(groups, roles, answer, o.levels[2], "mesh_check");
     Proposals p{check ? check->case_ca : kNone, {}};
     const Transition t = analyse_group(answer.key, answer.samples, o.d12_threshold);
-    for (const auto& x : {t.ca_star_below, t.ca_star_low, t.ca_star_high, t.ca_star_above, t.ca_h_low, t.ca_h_high})
-      p.add(x);
+    for (const auto& x : bracketing_ca(t)) p.add(x);
     if (!emit(answer.base, o.levels[2], p.ca, out, budget)) break;
   }
   return out;

@@ -151,6 +151,25 @@ TEST_F(ScriptsTest, Table1FromCapsimQueryJson) {
   EXPECT_NE(piped.out.find("Agree: 3, disagree: 1, missing: 6."), std::string::npos);
 }
 
+// Answers with errors (capsim query table1 of a schema-4 database) print "x ± e" and say how far the seed is.
+TEST_F(ScriptsTest, Table1PrintsErrorsAndHowFarTheSeedIs) {
+  const auto js = dir_ / "table1_err.json";
+  {
+    std::ofstream f(js);
+    f << R"([{"law": "neo-hookean", "aspect_ratio": 0.5, "ca_star_low": 0.025, "ca_star_high": 0.05,
+              "ca_h": 0.6034, "ca_star_low_err": 0.004, "ca_star_high_err": 0.012, "ca_h_err": 0.047},
+             {"law": "skalak", "aspect_ratio": 2.0, "ca_star_low": 0.216, "ca_star_high": 0.369,
+              "ca_h": 1.31, "ca_h_err": 0.12}])";
+  }
+  const Cmd r = sh(table1() + " --json " + q(js));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("0.60 ± 0.05 · seed 0.70"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("[0.025 ± 0.004, 0.05 ± 0.02]"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("seed 2.1 errors away"), std::string::npos) << r.out;  // |0.6034 - 0.70| / 0.047
+  EXPECT_NE(r.out.find("1.3 ± 0.2 · seed 1.40"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("seed within our error"), std::string::npos) << r.out;  // |1.31 - 1.40| < 0.12
+}
+
 TEST_F(ScriptsTest, MissingInputsExitTwoWithOneMessage) {
   const auto nope = dir_ / "does-not-exist";
   for (const std::string& cmd :

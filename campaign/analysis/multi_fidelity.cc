@@ -10,7 +10,6 @@ namespace capsim::campaign {
 
 namespace {
 
-bool same_ca(double a, double b) { return std::fabs(a - b) <= 1e-12 * std::max(1.0, std::fabs(b)); }
 
 // The group of the same cell as `like` at `level` with role `role`, or nullptr.
 const SampleGroup* find_group(const std::vector<SampleGroup>& groups, const std::vector<std::string>& roles,

@@ -26,7 +26,7 @@ std::vector<double> propose_refinement(const Transition& t, std::vector<Sample> 
   auto add = [&](double x) {
     x = quantise_ca(x, tol);
     if (!(x > 0)) return;
-    auto same = [x](double y) { return std::fabs(y - x) < 1e-12 * std::max(1.0, x); };
+    auto same = [x](double y) { return same_ca(y, x); };
     for (const auto& s : samples)
       if (same(s.ca)) return;
     // A case at this Ca exists already (queued, unstable or failed): proposing it adds nothing.

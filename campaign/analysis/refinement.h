@@ -3,6 +3,8 @@
 /// @brief The adaptive mode's refinement: which capillary numbers to add so the Ca* edges and the CaH
 /// bracket of each group shrink below the tolerance. Pure: the caller adds the cases to the store.
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "campaign/analysis/transitions.h"
@@ -12,6 +14,10 @@ namespace capsim::campaign {
 /// @brief @p x rounded to the decimal quantum of new capillary numbers: 10^-k, the largest below
 /// @p tolerance / 2 (exact decimals: 0.0275, not 0.027500000000000004).
 double quantise_ca(double x, double tolerance);
+
+/// @brief Whether two capillary numbers are the same sample (equal to 1e-12 relative): the one test every
+/// phase of the analysis uses to find a case at a Ca.
+inline bool same_ca(double a, double b) { return std::fabs(a - b) < 1e-12 * std::max(1.0, std::fabs(b)); }
 
 /// @brief Capillary numbers to add to a group with transition @p t so its Ca* edges and CaH bracket shrink
 /// below @p tolerance; values are rounded to a decimal quantum below the tolerance and never repeat a Ca in

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "campaign/analysis/refinement.h"
 #include "campaign/grid/precision.h"
 
 namespace capsim::campaign {
@@ -22,7 +23,6 @@ std::optional<double> spread(const Sample& s, Quantity q) {
 }
 const char* name_of(Quantity q) { return q == Quantity::kMinD12 ? "min D12" : "max τmin"; }
 
-bool same_ca(double a, double b) { return std::fabs(a - b) <= 1e-12 * std::max(1.0, std::fabs(b)); }
 
 // The samples of a group that have q, sorted by Ca.
 std::vector<const Sample*> with_value(const SampleGroup& g, Quantity q) {

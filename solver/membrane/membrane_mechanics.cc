@@ -65,6 +65,13 @@ bool point_kinematics(const mesh::P2Tabulation& p2, const Eigen::Matrix3Xd& x, c
   return k.det_g > 0.0;
 }
 
+// Collapsed relative to the reference: an area ratio Js below 1e-10 (Js² = det g / det G). A test on
+// det g > 0 alone is not enough: the tangents of an element whose six nodes coincide are Σ_a ∂N_a x0,
+// zero only up to the rounding of Σ_a ∂N_a, and on some instruction sets that leaves det g ≈ 1e-32 > 0.
+bool collapsed_against(const double* Ginv, const PointKinematics& k) {
+  return !(k.det_g * (Ginv[0] * Ginv[2] - Ginv[1] * Ginv[1]) > 1e-20);
+}
+
 [[noreturn]] void collapsed(int e) {
   throw DegenerateSurface("membrane: element " + std::to_string(e) + " collapsed or non-finite");
 }
@@ -77,8 +84,9 @@ void MembraneMechanics::for_each_point(const Eigen::Matrix3Xd& x, Visit&& visit)
     const auto& el = mesh_.elements[e];
     for (int q = 0; q < nq; ++q) {
       PointKinematics k;
-      if (!point_kinematics(p2_, x, el, q, k)) collapsed(e);
-      visit(e, q, ref_[static_cast<std::size_t>(e) * nq + q], k);
+      const RefPoint& r = ref_[static_cast<std::size_t>(e) * nq + q];
+      if (!point_kinematics(p2_, x, el, q, k) || collapsed_against(r.Ginv, k)) collapsed(e);
+      visit(e, q, r, k);
     }
   }
 }
@@ -119,11 +127,11 @@ MembraneState MembraneMechanics::evaluate(const Eigen::Matrix3Xd& x) const {
     double tmin = std::numeric_limits<double>::infinity(), tmax = -std::numeric_limits<double>::infinity();
     for (int q = 0; q < nq; ++q) {
       PointKinematics k;
-      if (!point_kinematics(p2_, x, el, q, k)) {
+      const RefPoint& r = ref_[static_cast<std::size_t>(e) * nq + q];
+      if (!point_kinematics(p2_, x, el, q, k) || collapsed_against(r.Ginv, k)) {
         first_collapsed = std::min(first_collapsed, e);
         break;
       }
-      const RefPoint& r = ref_[static_cast<std::size_t>(e) * nq + q];
       const Invariants inv = invariants(r, k);
       we += r.weight0 * law_.energy(inv.I1, inv.Js);
       const EnergyDerivatives d = law_.derivatives(inv.I1, inv.Js);

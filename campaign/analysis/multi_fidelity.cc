@@ -97,7 +97,17 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
         return beyond ? std::optional<double>(quantise_ca(x / 1.5, o.ca_tolerance)) : std::nullopt;
       };
       if (ta.ca_h_low && !ta.ca_h_high) p.add(above(*ta.ca_h_low, true));
-      if (ta.ca_h_high && !ta.ca_h_low) p.add(below(*ta.ca_h_high, true));
+      if (ta.ca_h_high && !ta.ca_h_low) {
+        // max τmin < 0 at every answer-level sample is ambiguous: a membrane is compressed both above CaH
+        // and below a lower critical number CaL (Lac et al. 2004; the NH sphere on level 3: τ < 0 at 0.4,
+        // > 0 at 0.5, < 0 again above 0.62). So probe both ways: below the smallest sample, and the next
+        // scan Ca above the largest one (within the scan's range: the grid's author chose it).
+        p.add(below(*ta.ca_h_high, true));
+        double largest = *ta.ca_h_high;
+        for (const auto& s : answer->samples)
+          if (s.max_tau_min) largest = std::max(largest, s.ca);
+        p.add(above(largest, false));
+      }
       if (ta.ca_star_low && !ta.ca_star_below) p.add(below(*ta.ca_star_low, false));
       if (ta.ca_star_high && !ta.ca_star_above) p.add(above(*ta.ca_star_high, false));
       // Refine: bisect, each bracket down to max(ca_tolerance, its numerical error).

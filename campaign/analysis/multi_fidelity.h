@@ -9,7 +9,9 @@
 ///    sample of smallest min D12 while no Ca* was found — are run on the answer level;
 /// 3. **re-bracket**: where the answer level does not bracket an answer the scan level did (the oblate NH
 ///    CaH is 0.23 on level 2 and 0.60 on level 3), the next scan Ca outwards is run on the answer level
-///    (beyond the scan's range: ×1.5 or ÷1.5), until the answer level brackets it;
+///    (beyond the scan's range: ×1.5 or ÷1.5), until the answer level brackets it; where max τmin < 0 at
+///    every answer-level sample, the next scan Ca above the largest sample is run too (a membrane is
+///    compressed below a lower critical CaL as well as above CaH, so "all negative" does not say which side);
 /// 4. **refine** (adaptive mode): bisection on the answer level (analysis/refinement.h), each bracket
 ///    stopping once it is narrower than max(ca_tolerance, the answer's numerical error): refining a bracket
 ///    below what the mesh resolves buys nothing; without a Ca* band the minimum of min D12 is bracketed only

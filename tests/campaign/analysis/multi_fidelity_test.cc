@@ -75,6 +75,30 @@ TEST(MultiFidelity, TheAnswerLevelReBracketsWhereTheScanWasWrong) {
   EXPECT_EQ(ca_at(add, 3), (std::vector<double>{0.625}));
 }
 
+TEST(MultiFidelity, AllCompressedOnTheAnswerLevelProbesBothWays) {
+  // The NH sphere: max τmin < 0 below CaL ≈ 0.42 and above CaH ≈ 0.62, > 0 between (level 3); the coarse
+  // scan sees no positive value at all. One answer-level sample at 0.4 (τ < 0) does not say on which side
+  // of the positive band it lies: the round must look above it too, not only below.
+  const auto tau_sphere = [](double ca) { return (ca - 0.42) * (0.62 - ca); };
+  const auto tau_coarse = [](double) { return -0.01; };
+  std::vector<CaseSample> cases;
+  for (double ca : {0.4, 0.6, 0.8}) cases.push_back(fake(2, ca, tau_coarse));
+  cases.push_back(fake(3, 0.4, tau_sphere));
+  auto add = answer_level_round(group_cases(cases), kOptions, 100);
+  const auto proposed = ca_at(add, 3);
+  EXPECT_TRUE(std::find(proposed.begin(), proposed.end(), 0.6) != proposed.end()) << "the next scan Ca above";
+  // With 0.6 (τ > 0) and 0.8 (τ < 0) in, CaH is bracketed by the upper crossing and bisected there.
+  for (double ca : proposed) cases.push_back(fake(3, ca, tau_sphere));
+  add = answer_level_round(group_cases(cases), kOptions, 100);
+  cases.push_back(fake(3, 0.8, tau_sphere));
+  add = answer_level_round(group_cases(cases), kOptions, 100);
+  for (double ca : ca_at(add, 3)) {
+    EXPECT_GT(ca, 0.6);
+    EXPECT_LT(ca, 0.8);
+  }
+  EXPECT_FALSE(add.empty());
+}
+
 TEST(MultiFidelity, RefinementStopsAtTheNumericalError) {
   // The level-2 and level-3 values differ by 0.37 in τ (slope −1): the CaH error is 0.37, so a bracket of
   // width 0.1 is already narrower than what the mesh resolves; with a level 2 close to level 3 it is not.

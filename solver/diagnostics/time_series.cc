@@ -34,22 +34,26 @@ void TimeSeries::push_back(const StepRecord& r) {
   volume.push_back(r.volume);
   area.push_back(r.area);
   P.push_back(r.P);
+  bending_energy.push_back(r.bending_energy);
+  max_bending_moment.push_back(r.max_bending_moment);
 }
 
 StepRecord TimeSeries::at(std::size_t i) const {
   if (i >= size()) throw std::out_of_range("TimeSeries::at: index out of range");
-  return {t[i], D12[i], L1[i], L2[i], theta[i], tau_min[i], volume[i], area[i], P[i]};
+  return {t[i], D12[i], L1[i], L2[i], theta[i], tau_min[i], volume[i], area[i], P[i], bending_energy[i],
+          max_bending_moment[i]};
 }
 
 void TimeSeries::truncate(std::size_t n) {
   if (n >= size()) return;
-  for (auto* c : {&t, &D12, &L1, &L2, &theta, &tau_min, &volume, &area}) c->resize(n);
+  for (auto* c : {&t, &D12, &L1, &L2, &theta, &tau_min, &volume, &area, &bending_energy, &max_bending_moment})
+    c->resize(n);
   P.resize(n);
 }
 
 bool TimeSeries::consistent() const {
   const std::size_t n = t.size();
-  for (const auto* c : {&D12, &L1, &L2, &theta, &tau_min, &volume, &area})
+  for (const auto* c : {&D12, &L1, &L2, &theta, &tau_min, &volume, &area, &bending_energy, &max_bending_moment})
     if (c->size() != n) return false;
   return P.size() == n;
 }

@@ -23,6 +23,8 @@ struct StepRecord {
   double volume = 0;   ///< enclosed volume
   double area = 0;     ///< surface area
   std::array<double, 3> P{};  ///< position of the material point P
+  double bending_energy = 0;      ///< W_b, units Gs ℓ² (0 without bending stiffness)
+  double max_bending_moment = 0;  ///< max κ_b |c − c0| over the surface, units Gs ℓ (0 without bending)
 };
 
 /// @brief Measure everything but τmin (which the membrane provides) on positions x at time t.
@@ -35,6 +37,7 @@ StepRecord measure_step(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x
 struct TimeSeries {
   std::vector<double> t, D12, L1, L2, theta, tau_min, volume, area;
   std::vector<std::array<double, 3>> P;
+  std::vector<double> bending_energy, max_bending_moment;
 
   /// @brief Append one record.
   void push_back(const StepRecord& r);

@@ -197,6 +197,8 @@ class CaseRun {
       next_snapshot_ += config_.snapshot_interval;
     }
     record_.tau_min = info.start.tau_min;
+    record_.bending_energy = info.start.bending_energy;
+    record_.max_bending_moment = info.start.max_bending_moment;
     if (t_ >= next_sample_ - eps_) {
       series_.push_back(record_);
       writer_->append(record_);

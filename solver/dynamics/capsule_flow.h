@@ -19,6 +19,7 @@
 #include <Eigen/Core>
 
 #include "solver/config/case_config.h"
+#include "solver/membrane/bending.h"
 #include "solver/membrane/load_solver.h"
 #include "solver/membrane/membrane_law.h"
 #include "solver/membrane/membrane_mechanics.h"
@@ -35,12 +36,14 @@ struct FlowEvaluation {
   double max_speed = 0.0;       ///< max |v − v∞| over the nodes
   bool used_symmetry = false;   ///< whether the boundary integral used the mirror symmetry
   double volume_flux = 0.0;     ///< ∫ v·n dS of the uncorrected discrete velocity (0 for the exact flow)
+  double bending_energy = 0.0;  ///< W_b on x (0 without bending stiffness)
+  double max_bending_moment = 0.0;  ///< max κ_b |c − c0| on x (solver/membrane/bending.h)
 };
 
 /// @brief Accumulated wall time of the phases of flow evaluations (exafmm-style named phases).
 /// The boundary integral's total (stokes_s) is split into the SingleLayer phases (SingleLayerStats).
 struct FlowTimings {
-  double membrane_s = 0.0;   ///< kinematics, energy gradient
+  double membrane_s = 0.0;   ///< kinematics, energy gradient (elastic, and bending when κ_b > 0)
   double load_s = 0.0;       ///< mass matrix assembly + factorisation + solve
   double stokes_s = 0.0;     ///< boundary integral: the sum of the five phases below
   double layout_s = 0.0;     ///< symmetry check, quadrature points laid out as SoA
@@ -67,9 +70,14 @@ class CapsuleFlow {
   FlowEvaluation velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, Eigen::Matrix3Xd* load = nullptr);
   /// @brief The membrane load q on positions x alone (membrane + load solve, no boundary integral): for
   /// diagnostics that need q but not v. Not counted as a flow evaluation; its time goes to the membrane and
-  /// load phases. Returns the membrane state (tensions, forces).
+  /// load phases. Returns the membrane state (tensions, elastic forces); with bending stiffness q includes
+  /// the bending load, whose energy and largest moment last_bending() holds.
   /// @throws membrane::DegenerateSurface if x has a collapsed element.
   membrane::MembraneState membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q);
+  /// @brief Bending energy and largest moment of the last membrane_load / velocity (zero without bending).
+  [[nodiscard]] const membrane::BendingState& last_bending() const { return bending_state_; }
+  /// @brief κ_b (capsule.bending_modulus).
+  [[nodiscard]] double bending_modulus() const { return bending_ ? bending_->model().modulus() : 0.0; }
 
   [[nodiscard]] const mesh::SurfaceMesh& mesh() const { return *mesh_; }
   [[nodiscard]] const Eigen::Matrix3Xd& reference() const { return mesh_->nodes; }
@@ -87,6 +95,8 @@ class CapsuleFlow {
   std::unique_ptr<membrane::MembraneLaw> law_;
   std::unique_ptr<membrane::MembraneMechanics> mechanics_;
   std::unique_ptr<membrane::LoadSolver> load_solver_;
+  std::unique_ptr<membrane::BendingMechanics> bending_;  // null when κ_b = 0: the seed's membrane, untouched
+  membrane::BendingState bending_state_;
   std::unique_ptr<stokes::SingleLayer> single_layer_;
   Eigen::Matrix3Xd q_, u_;
   FlowTimings timings_;
@@ -119,7 +129,10 @@ inline constexpr double kLargeCaCoefficient = 0.75;
 
 /// @brief The automatic dt of a case (time.dt = "auto"): rk2 → the stable dt above with time.dt_factor;
 /// rkc → time.dt_accuracy (accuracy-limited, the stages follow the stiffness), but never less than the rk2
-/// dt (at large Ca the stiffness is mild and the rk2 step is already accurate).
+/// dt (at large Ca the stiffness is mild and the rk2 step is already accurate). With bending stiffness the rk2
+/// dt shrinks by the ratio of the elastic to the total stiffness at the reference,
+/// 1 / (1 + kBendingSpectralConstant κ_b / (kSpectralRadiusConstant h_min²)) (time_stepper.h): rk2 must stay
+/// stable, rkc keeps its accuracy step and takes the stages the stiffness needs.
 double automatic_time_step(const config::CaseConfig& config, const mesh::SurfaceMesh& mesh);
 
 }  // namespace capsim::dynamics

@@ -86,7 +86,7 @@ StepInfo RkcIntegrator::step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt, 
   info.start = flow.velocity(x, f0_, start ? &start->load : nullptr);
   if (start) start->velocity = f0_;
   const double rho = options_.safety * membrane_spectral_radius(flow.mesh(), x, flow.capillary_number(),
-                                                                info.start.tau_max);
+                                                                info.start.tau_max, flow.bending_modulus());
   last_rho_ = rho;
   const int s = stages_for(dt * rho, options_.damping);
   if (s > options_.max_stages)
@@ -133,9 +133,10 @@ std::unique_ptr<TimeIntegrator> make_integrator(const std::string& scheme, doubl
 }
 
 double membrane_spectral_radius(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x, double capillary_number,
-                                double tau_max) {
-  return kSpectralRadiusConstant * (1.0 + kPrestressCoefficient * std::max(tau_max, 0.0)) /
-         (capillary_number * mesh::min_node_spacing(mesh, x));
+                                double tau_max, double bending_modulus) {
+  const double h = mesh::min_node_spacing(mesh, x);
+  return kSpectralRadiusConstant * (1.0 + kPrestressCoefficient * std::max(tau_max, 0.0)) / (capillary_number * h) +
+         kBendingSpectralConstant * bending_modulus / (capillary_number * h * h * h);
 }
 
 double estimate_spectral_radius(CapsuleFlow& flow, const Eigen::Matrix3Xd& x, int iterations) {

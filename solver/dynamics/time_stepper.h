@@ -146,10 +146,16 @@ std::unique_ptr<TimeIntegrator> make_integrator(const std::string& scheme, doubl
 /// Ca; on sheared, prestressed states (level 2, γ̇t = 3) ρ Ca h_min(x) / (1 + 0.4 τmax) = 4.5–5.4 for
 /// Ca = 0.3–1 (τmax = 0.65–3.3): the prestress stiffens the fast modes (geometric stiffness), which is
 /// what lowers the explicit limit at large Ca. The constants bound every measurement from above.
+///
+/// With bending stiffness κ_b (solver/membrane/bending.h) a mode of wavelength ∝ h relaxes at a rate
+/// ∝ κ_b/(Ca h³) (the load ∝ κ_b k⁴ against the Stokes mobility ∝ 1/k); the estimate adds
+///   kBendingSpectralConstant · κ_b / (Ca · h_min(x)³),
+/// calibrated by power iteration the same way (tests/solver/dynamics/spectral_radius_validation.cc).
 double membrane_spectral_radius(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x, double capillary_number,
-                                double tau_max);
+                                double tau_max, double bending_modulus = 0.0);
 inline constexpr double kSpectralRadiusConstant = 6.5;
 inline constexpr double kPrestressCoefficient = 0.4;
+inline constexpr double kBendingSpectralConstant = 45.0;
 
 /// @brief Power-iteration estimate of the spectral radius of J = ∂v/∂x at x (finite differences of v,
 /// `iterations` flow evaluations plus one). For tests and calibration; the mirror symmetry of a symmetric

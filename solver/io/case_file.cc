@@ -22,6 +22,7 @@ struct Column {
   const char* name;
   const char* units;
   std::vector<double> diagnostics::TimeSeries::*member;
+  bool optional = false;  // added later (issue 15): a file without it reads as zeros
 };
 constexpr Column kColumns[] = {
     {"t", "1/shear_rate", &diagnostics::TimeSeries::t},
@@ -32,6 +33,8 @@ constexpr Column kColumns[] = {
     {"tau_min", "Gs", &diagnostics::TimeSeries::tau_min},
     {"volume", "l^3", &diagnostics::TimeSeries::volume},
     {"area", "l^2", &diagnostics::TimeSeries::area},
+    {"bending_energy", "Gs*l^2", &diagnostics::TimeSeries::bending_energy, true},
+    {"max_bending_moment", "Gs*l", &diagnostics::TimeSeries::max_bending_moment, true},
 };
 
 std::string ts(const char* col) { return std::string("timeseries/") + col; }
@@ -94,14 +97,16 @@ struct CaseWriter::Impl {
     h5::write_attribute(f.get(), Attribute("code_version", kGitCommit), file);
     h5::write_attribute(f.get(), Attribute("capsim_version", kVersion), file);
     for (const auto& p : parameters) h5::write_attribute(f.get(), p, file);
-    for (const auto& c : kColumns) {
-      h5::create_extendible(f.get(), ts(c.name), 0, options.chunk_rows, file);
-      h5::Handle d = h5::checked(H5Dopen2(f.get(), ts(c.name).c_str(), H5P_DEFAULT), H5Dclose, file, "open");
-      h5::write_attribute(d.get(), Attribute("units", c.units), file);
-    }
+    for (const auto& c : kColumns) create_column(c);
     h5::create_extendible(f.get(), ts("P"), 3, options.chunk_rows, file);
     h5::Handle g = h5::checked(H5Gcreate2(f.get(), "snapshots", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
                                file, "cannot create group snapshots");
+  }
+
+  void create_column(const Column& c) {
+    h5::create_extendible(f.get(), ts(c.name), 0, options.chunk_rows, file);
+    h5::Handle d = h5::checked(H5Dopen2(f.get(), ts(c.name).c_str(), H5P_DEFAULT), H5Dclose, file, "open");
+    h5::write_attribute(d.get(), Attribute("units", c.units), file);
   }
 
   void write_pending() {
@@ -179,7 +184,11 @@ CaseWriter CaseWriter::resume(const std::filesystem::path& file, const std::vect
       if (p.key == r) throw std::invalid_argument("case file parameter name '" + p.key + "' is reserved");
   for (const auto& p : parameters) h5::write_attribute(impl->f.get(), p, file);
   // Replace the series by the checkpoint's: shrink to 0 and append it again (the series is small).
-  for (const auto& c : kColumns) h5::set_rows(impl->f.get(), ts(c.name), 0, 0, file);
+  impl->options.chunk_rows = std::max<std::size_t>(options.chunk_rows, 1);
+  for (const auto& c : kColumns) {
+    if (c.optional && !h5::exists(impl->f.get(), ts(c.name))) impl->create_column(c);  // a file from before it
+    h5::set_rows(impl->f.get(), ts(c.name), 0, 0, file);
+  }
   h5::set_rows(impl->f.get(), ts("P"), 3, 0, file);
   // Drop snapshots taken after the checkpoint: the restarted run will write them again.
   const double t_last = series.empty() ? -std::numeric_limits<double>::infinity() : series.t.back();
@@ -327,7 +336,8 @@ CaseFileContents read_case_file(const std::filesystem::path& file) {
   const std::size_t n = dims[0];
   for (const auto& col : kColumns) {
     auto& v = c.series.*col.member;
-    v.resize(n);
+    v.assign(n, 0.0);
+    if (col.optional && !h5::exists(f.get(), ts(col.name))) continue;
     h5::read_dataset(f.get(), ts(col.name), n, v.data(), file);
   }
   c.series.P.resize(n);

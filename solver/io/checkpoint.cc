@@ -21,12 +21,15 @@ constexpr auto kFixed = h5::StringStorage::Fixed;
 struct Column {
   const char* name;
   std::vector<double> diagnostics::TimeSeries::*member;
+  bool optional = false;  // added later (issue 15): a checkpoint without it reads as zeros, hashed without it
 };
 constexpr Column kColumns[] = {
     {"t", &diagnostics::TimeSeries::t},           {"D12", &diagnostics::TimeSeries::D12},
     {"L1", &diagnostics::TimeSeries::L1},         {"L2", &diagnostics::TimeSeries::L2},
     {"theta", &diagnostics::TimeSeries::theta},   {"tau_min", &diagnostics::TimeSeries::tau_min},
     {"volume", &diagnostics::TimeSeries::volume}, {"area", &diagnostics::TimeSeries::area},
+    {"bending_energy", &diagnostics::TimeSeries::bending_energy, true},
+    {"max_bending_moment", &diagnostics::TimeSeries::max_bending_moment, true},
 };
 
 std::string ts(const char* col) { return std::string("timeseries/") + col; }
@@ -52,7 +55,8 @@ class Fnv1a {
   std::uint64_t h_ = 0xcbf29ce484222325ULL;
 };
 
-std::uint64_t checksum(const Checkpoint& c) {
+// with_optional = false: the checksum of a checkpoint written before the optional columns existed.
+std::uint64_t checksum(const Checkpoint& c, bool with_optional = true) {
   Fnv1a h;
   h.value(static_cast<std::uint64_t>(c.positions.cols()));
   h.bytes(c.positions.data(), sizeof(double) * static_cast<std::size_t>(c.positions.size()));
@@ -61,6 +65,7 @@ std::uint64_t checksum(const Checkpoint& c) {
   h.value(c.dt);
   h.value(static_cast<std::uint64_t>(c.series.size()));
   for (const auto& col : kColumns) {
+    if (col.optional && !with_optional) continue;
     const auto& v = c.series.*col.member;
     h.bytes(v.data(), sizeof(double) * v.size());
   }
@@ -148,7 +153,13 @@ Checkpoint read_checkpoint(const std::filesystem::path& file) {
   h5::read_dataset(id, "positions", 3 * static_cast<std::size_t>(num_nodes), c.positions.data(), file);
 
   const auto n = static_cast<std::size_t>(num_records);
+  bool has_optional = true;
   for (const auto& col : kColumns) {
+    if (col.optional && !h5::exists(id, ts(col.name))) {
+      (c.series.*col.member).assign(n, 0.0);
+      has_optional = false;
+      continue;
+    }
     const auto d = h5::dataset_dims(id, ts(col.name), file);
     if (d.size() != 1 || d[0] != n)
       throw IoError(file, "dataset " + ts(col.name) + " does not have num_records = " + std::to_string(n) + " rows");
@@ -176,7 +187,7 @@ Checkpoint read_checkpoint(const std::filesystem::path& file) {
     }
   }
   f.close(file, "cannot close checkpoint");
-  if (checksum(c) != stored_sum) throw IoError(file, "checkpoint is corrupt (checksum mismatch)");
+  if (checksum(c, has_optional) != stored_sum) throw IoError(file, "checkpoint is corrupt (checksum mismatch)");
   return c;
 }
 

@@ -1,4 +1,4 @@
-// Case configuration: the far-field keys of the boundary integral (parsing, ranges, echo).
+// Case configuration: the far-field keys of the boundary integral and the bending modulus (parsing, ranges, echo).
 #include "solver/config/case_config.h"
 
 #include <algorithm>
@@ -54,6 +54,20 @@ TEST(CaseConfig, FarFieldKeysAreListed) {
   const auto names = case_key_names();
   EXPECT_NE(std::find(names.begin(), names.end(), "numerics.far_degree"), names.end());
   EXPECT_NE(std::find(names.begin(), names.end(), "numerics.far_radius"), names.end());
+}
+
+TEST(CaseConfig, BendingModulusDefaultsToNoneAndIsRangeChecked) {
+  EXPECT_EQ(parse_case_config("", "empty").bending_modulus, 0.0);
+  EXPECT_EQ(parse_case_config("[capsule]\nbending_modulus = 1e-3\n", "case.toml").bending_modulus, 1e-3);
+  EXPECT_EQ(parse_case_config("", "case.toml", {"capsule.bending_modulus=0.01"}).bending_modulus, 0.01);
+  for (const char* bad : {"capsule.bending_modulus=-1e-3", "capsule.bending_modulus=2", "capsule.bending_modulus=nan"}) {
+    try {
+      (void)parse_case_config("", "case.toml", {bad});
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("capsule.bending_modulus"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

@@ -24,7 +24,8 @@ std::filesystem::path scratch(const std::string& name) {
 diagnostics::StepRecord record(int i) {
   const double t = 0.01 * i;
   return {t, 0.3 + 0.1 * std::sin(t), 1.2 + 0.01 * i, 0.8 - 1e-3 * i, std::remainder(-0.5 * t, M_PI),
-          -0.01 * std::cos(3 * t), 4.18879 + 1e-9 * i, 13.2 + 1e-8 * i, {std::cos(t), std::sin(t), 0.0}};
+          -0.01 * std::cos(3 * t), 4.18879 + 1e-9 * i, 13.2 + 1e-8 * i, {std::cos(t), std::sin(t), 0.0},
+          1e-3 * (1 + std::sin(t)), 2e-3 * i};
 }
 
 std::string slurp(const std::filesystem::path& p) {
@@ -186,6 +187,31 @@ TEST(CaseFile, AssigningOverAnOpenWriterWritesItsBufferedRows) {
   EXPECT_EQ(read_case_file(first).series.size(), 10u);
   w.close();
   EXPECT_EQ(read_case_file(second).series.size(), 0u);
+}
+
+// A case file written before the bending columns existed (committed fixture, made by the code of 2b1b812:
+// `capsim run - --set mesh.level=0 --set time.t_end=1 --stop-after 5`) reads with zero bending columns,
+// and a resumed run continues in it with all columns.
+TEST(CaseFile, FileFromBeforeTheBendingColumnsReadsAndResumes) {
+  const auto file = scratch("pre_bending_case.h5");
+  std::filesystem::copy_file(std::filesystem::path(CAPSIM_SOURCE_DIR) / "tests/solver/io/data/pre_bending_case.h5",
+                             file, std::filesystem::copy_options::overwrite_existing);
+  const auto c = read_case_file(file);
+  ASSERT_GT(c.series.size(), 0u);
+  EXPECT_TRUE(c.series.consistent());
+  for (std::size_t i = 0; i < c.series.size(); ++i) {
+    EXPECT_EQ(c.series.bending_energy[i], 0.0);
+    EXPECT_EQ(c.series.max_bending_moment[i], 0.0);
+  }
+  {
+    CaseWriter w = CaseWriter::resume(file, {}, c.series);
+    w.append(record(7));
+    w.close();
+  }
+  const auto r = read_case_file(file);
+  ASSERT_EQ(r.series.size(), c.series.size() + 1);
+  EXPECT_EQ(r.series.max_bending_moment.back(), record(7).max_bending_moment);
+  EXPECT_EQ(r.series.D12[0], c.series.D12[0]);
 }
 
 }  // namespace

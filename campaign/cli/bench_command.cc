@@ -1,7 +1,7 @@
 // `capsim bench kernel [--json] [--threads N] [--repeat R]`: the Stokeslet kernel on a level-3-sized problem
 // (2562 targets × all regular quadrature points of the level-3 sphere), fast kernel against the plain
 // `omp simd` loop, so users can check a new machine (issue 6 §1).
-// `capsim bench flow [--level L] [--json] [--threads N] [--repeat R]`: one flow evaluation by named phase
+// `capsim bench flow [--level L] [--bending KB] [--json] [--threads N] [--repeat R]`: one flow evaluation by named phase
 // against the bare regular Stokeslet sum in the same run (solver/dynamics/flow_benchmark.h, issue 13 §1).
 #include <omp.h>
 
@@ -27,7 +27,7 @@ namespace sk = capsim::stokes::kernel;
 void usage_error(const std::string& msg) {
   std::fprintf(stderr,
                "capsim bench: %s (usage: capsim bench kernel [--json] [--threads N] [--repeat R]; "
-               "capsim bench flow [--level L] [--json] [--threads N] [--repeat R])\n",
+               "capsim bench flow [--level L] [--bending KB] [--json] [--threads N] [--repeat R])\n",
                msg.c_str());
 }
 
@@ -76,6 +76,7 @@ double max_rel_error(const std::vector<double>& ux, const std::vector<double>& u
 struct BenchArgs {
   bool json = false;
   int threads = 0, repeat = 0, level = 3;
+  double bending = 0.0;
 };
 
 // Parses the options after the benchmark's name; `level` only where allowed. False after a usage error.
@@ -84,6 +85,20 @@ bool parse_args(const std::vector<std::string>& args, bool allow_level, BenchArg
     const std::string& a = args[k];
     if (a == "--json") {
       out.json = true;
+    } else if (allow_level && a == "--bending") {
+      std::size_t used = 0;
+      double v = -1;
+      try {
+        if (k + 1 < args.size()) v = std::stod(args[k + 1], &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (k + 1 >= args.size() || used != args[k + 1].size() || !(v >= 0.0 && v <= 1.0)) {
+        usage_error("--bending needs a bending modulus in [0, 1] (capsule.bending_modulus)");
+        return false;
+      }
+      out.bending = v;
+      ++k;
     } else if (a == "--threads" || a == "--repeat" || (allow_level && a == "--level")) {
       if (k + 1 >= args.size()) {
         usage_error(a + " needs a value");
@@ -108,6 +123,7 @@ int bench_flow(const BenchArgs& ba) {
   capsim::dynamics::FlowBenchOptions opt;
   opt.level = ba.level;
   opt.repeat = ba.repeat;
+  opt.bending_modulus = ba.bending;
   if (std::string why; !opt.valid(&why)) {
     usage_error(why);
     return kExitBadInput;
@@ -127,6 +143,7 @@ int bench_flow(const BenchArgs& ba) {
                         {"regular_sum_ms", s.regular_sum_ms},
                         {"overhead_ratio", s.overhead_ratio},
                         {"membrane_ms", s.membrane_ms},
+                        {"bending_ms", s.bending_ms},
                         {"load_ms", s.load_ms},
                         {"layout_ms", s.layout_ms},
                         {"regular_ms", s.regular_ms},
@@ -148,15 +165,17 @@ int bench_flow(const BenchArgs& ba) {
     std::printf("%s\n", j.dump().c_str());
     return 0;
   }
-  std::printf("Flow evaluation, level %d (%d nodes), a/b = 2 Skalak Ca = 0.3 deformed, %d thread(s), kernel %s\n",
-              r.level, r.scenes.front().nodes, r.threads, r.isa.c_str());
-  std::printf("%-10s %7s %9s %9s %8s | %8s %8s %8s %8s %8s %8s %8s %8s %8s\n", "scene", "targets", "eval ms",
-              "bare ms", "ratio", "membrane", "load", "layout", "regular", "far", "singular", "near", "volume",
-              "other");
+  std::printf("Flow evaluation, level %d (%d nodes), a/b = 2 Skalak Ca = 0.3 deformed, bending modulus %g, %d "
+              "thread(s), kernel %s\n",
+              r.level, r.scenes.front().nodes, ba.bending, r.threads, r.isa.c_str());
+  std::printf("%-10s %7s %9s %9s %8s | %8s %8s %8s %8s %8s %8s %8s %8s %8s %8s\n", "scene", "targets", "eval ms",
+              "bare ms", "ratio", "membrane", "bending", "load", "layout", "regular", "far", "singular", "near",
+              "volume", "other");
   for (const auto& s : r.scenes)
-    std::printf("%-10s %7d %9.3f %9.3f %8.3f | %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f\n",
+    std::printf("%-10s %7d %9.3f %9.3f %8.3f | %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f\n",
                 s.name.c_str(), s.targets, s.evaluation_ms, s.regular_sum_ms, s.overhead_ratio, s.membrane_ms,
-                s.load_ms, s.layout_ms, s.regular_ms, s.far_ms, s.singular_ms, s.near_ms, s.volume_ms, s.other_ms);
+                s.bending_ms, s.load_ms, s.layout_ms, s.regular_ms, s.far_ms, s.singular_ms, s.near_ms, s.volume_ms,
+                s.other_ms);
   std::printf("ratio = evaluation / bare regular sum over the same targets and sources (medians of %d, alternated);"
               " phases are means per evaluation in ms\n",
               r.scenes.front().repeat);

@@ -1,5 +1,6 @@
 // `capsim query table1|cases|sql`: read-only queries of a campaign database.
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -41,6 +42,14 @@ std::string law_label(const std::string& law, double C) {
 
 SqlValue value_of(const std::optional<double>& x) { return x ? SqlValue{*x} : SqlValue{nullptr}; }
 
+// capsule.bending_modulus of a transition group (stored only when set: absent means 0, the seed's membrane).
+double bending_modulus_of(const std::string& group_key) {
+  const auto j = nlohmann::json::parse(group_key, nullptr, false);
+  if (j.is_object() && j.contains("capsule.bending_modulus") && j["capsule.bending_modulus"].is_number())
+    return j["capsule.bending_modulus"].get<double>();
+  return 0.0;
+}
+
 int table1(campaign::Store& store, const std::string& name, campaign::Format fmt, int mesh_level, double skalak_C) {
   const std::string camp = resolve_campaign(store, name);
   std::vector<campaign::Transition> rows;
@@ -74,13 +83,14 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
     campaign::Table t;
     t.columns = {"law",          "aspect_ratio",     "ca_star_low", "ca_star_high", "ca_h",
                  "ca_star_low_err", "ca_star_high_err", "ca_h_err",    "mesh_level",   "error_levels",
-                 "ca_star_low_err_source", "ca_star_high_err_source", "ca_h_err_source"};
+                 "ca_star_low_err_source", "ca_star_high_err_source", "ca_h_err_source", "bending_modulus"};
     auto text_or_null = [](const std::string& x) { return x.empty() ? SqlValue{nullptr} : SqlValue{x}; };
     for (const auto& r : rows)
       t.rows.push_back({r.law, r.aspect_ratio, value_of(r.ca_star_low), value_of(r.ca_star_high), value_of(r.ca_h),
                         value_of(r.ca_star_low_err), value_of(r.ca_star_high_err), value_of(r.ca_h_err),
                         std::int64_t{r.mesh_level}, text_or_null(r.error_levels), text_or_null(r.ca_star_low_err_source),
-                        text_or_null(r.ca_star_high_err_source), text_or_null(r.ca_h_err_source)});
+                        text_or_null(r.ca_star_high_err_source), text_or_null(r.ca_h_err_source),
+                        bending_modulus_of(r.group_key)});
     std::printf("%s", campaign::render(t, fmt).c_str());
     return 0;
   }
@@ -126,6 +136,10 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
     }
     out += star + "\n" + h + "\n";
   }
+  // A membrane with bending stiffness is not the seed's: say so above the table (one value per campaign here,
+  // as two would be two groups per cell, refused above).
+  if (const double kb = bending_modulus_of(rows.front().group_key); kb > 0.0)
+    out = "Bending modulus κ_b = " + campaign::canonical_double(kb) + " (capsule.bending_modulus)\n\n" + out;
   std::printf("%s", out.c_str());
   return 0;
 }

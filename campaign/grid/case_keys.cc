@@ -29,6 +29,7 @@ const std::vector<std::pair<std::string, std::string>>& axis_aliases() {
       {"law", "capsule.law"},
       {"skalak_C", "capsule.skalak_C"},
       {"mesh_level", "mesh.level"},
+      {"bending_modulus", "capsule.bending_modulus"},
   };
   return aliases;
 }

@@ -58,6 +58,7 @@ double number(const std::map<std::string, Value>& m, const std::string& key) {
 double CaseParams::capillary_number() const { return number(values_, "flow.capillary_number"); }
 double CaseParams::aspect_ratio() const { return number(values_, "capsule.aspect_ratio"); }
 double CaseParams::skalak_C() const { return number(values_, "capsule.skalak_C"); }
+double CaseParams::bending_modulus() const { return number(values_, "capsule.bending_modulus"); }
 int CaseParams::mesh_level() const { return static_cast<int>(number(values_, "mesh.level")); }
 double CaseParams::t_end() const { return number(values_, "time.t_end"); }
 std::string CaseParams::law() const { return std::get<std::string>(value_or_default(values_, "capsule.law")); }

@@ -35,6 +35,8 @@ class CaseParams {
   std::string law() const;
   /// @brief capsule.skalak_C.
   double skalak_C() const;
+  /// @brief capsule.bending_modulus (0 when not set).
+  double bending_modulus() const;
   /// @brief mesh.level.
   int mesh_level() const;
   /// @brief time.t_end.

@@ -87,7 +87,7 @@ std::string result_mismatch(const nlohmann::json& j, const CaseParams& p) {
     return e.what();
   }
   return driver::parameter_mismatch(s.parameters, {p.capillary_number(), p.aspect_ratio(), p.law(), p.skalak_C(),
-                                                   p.mesh_level()});
+                                                   p.mesh_level(), p.bending_modulus()});
 }
 
 void insert_result(Db& db, const std::string& case_id, const nlohmann::json& j, const std::string& line) {

@@ -36,6 +36,7 @@ std::vector<io::Attribute> case_attributes(const config::CaseConfig& c) {
   a.emplace_back("law", c.law);
   a.emplace_back("skalak_C", c.skalak_C);
   a.emplace_back("mesh_level", c.level);
+  a.emplace_back("bending_modulus", c.bending_modulus);
   a.emplace_back("config_toml", c.to_toml());
   return a;
 }
@@ -269,7 +270,7 @@ class CaseRun {
     r_.steps = step_;
     r_.t_final = t_;
     r_.flow_evaluations = flow_->timings().evaluations;
-    r_.membrane_s = flow_->timings().membrane_s;
+    r_.membrane_s = flow_->timings().membrane_s + flow_->timings().bending_s;  // elastic + bending
     r_.load_s = flow_->timings().load_s;
     r_.stokes_s = flow_->timings().stokes_s;
     r_.case_file = case_file_;

@@ -59,7 +59,7 @@ struct CaseResult {
   double dt = 0;
   double t_final = 0;
   double wall_s = 0;
-  double membrane_s = 0, load_s = 0, stokes_s = 0;  ///< wall time of the phases
+  double membrane_s = 0, load_s = 0, stokes_s = 0;  ///< wall time of the phases (membrane: elastic + bending)
   std::filesystem::path case_file;
 };
 

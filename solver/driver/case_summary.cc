@@ -98,7 +98,7 @@ diagnostics::Regime regime_of(const std::string& name) {
 }  // namespace
 
 CaseParameters CaseParameters::of(const config::CaseConfig& c) {
-  return {c.capillary_number, c.aspect_ratio, c.law, c.skalak_C, c.level};
+  return {c.capillary_number, c.aspect_ratio, c.law, c.skalak_C, c.level, c.bending_modulus};
 }
 
 std::string parameter_mismatch(const CaseParameters& reported, const CaseParameters& expected) {
@@ -111,6 +111,8 @@ std::string parameter_mismatch(const CaseParameters& reported, const CaseParamet
   if (expected.law == "skalak" && !near(reported.skalak_C, expected.skalak_C))
     return "skalak_C " + text(reported.skalak_C);
   if (reported.mesh_level != expected.mesh_level) return "mesh_level " + std::to_string(reported.mesh_level);
+  if (!near(reported.bending_modulus, expected.bending_modulus))
+    return "bending_modulus " + text(reported.bending_modulus);
   return "";
 }
 
@@ -150,6 +152,7 @@ nlohmann::json CaseSummary::to_json() const {
       {"law", parameters.law},
       {"skalak_C", parameters.skalak_C},
       {"mesh_level", parameters.mesh_level},
+      {"bending_modulus", parameters.bending_modulus},
       {"regime", std::string(diagnostics::to_string(analysis.regime))},
       {"converged", converged},
       {"steps", steps},
@@ -180,6 +183,10 @@ CaseSummary CaseSummary::from_json(const nlohmann::json& j) {
   if (level == j.end() || !level->is_number_integer())
     throw std::invalid_argument("result: 'mesh_level' missing or not an integer");
   s.parameters.mesh_level = level->get<int>();
+  if (const auto kb = j.find("bending_modulus"); kb != j.end()) {  // absent in results from before the key: 0
+    if (!kb->is_number()) throw std::invalid_argument("result: 'bending_modulus' is not a number");
+    s.parameters.bending_modulus = kb->get<double>();
+  }
   s.analysis.regime = regime_of(string_or_empty(j, "regime"));
   const auto converged = j.find("converged");
   s.converged = converged != j.end() && converged->is_boolean() && converged->get<bool>();
@@ -203,6 +210,7 @@ std::vector<io::Attribute> summary_attributes(const CaseSummary& s) {
   a.emplace_back("law", s.parameters.law);
   a.emplace_back("skalak_C", s.parameters.skalak_C);
   a.emplace_back("mesh_level", s.parameters.mesh_level);
+  a.emplace_back("bending_modulus", s.parameters.bending_modulus);
   a.emplace_back("regime", std::string(diagnostics::to_string(s.analysis.regime)));
   a.emplace_back("converged", s.converged ? 1 : 0);
   a.emplace_back("steps", s.steps);

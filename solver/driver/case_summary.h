@@ -31,6 +31,7 @@ struct CaseParameters {
   std::string law;
   double skalak_C = 0;  ///< enters the case only for the Skalak law
   int mesh_level = 0;
+  double bending_modulus = 0;  ///< κ_b (JSON "bending_modulus"; a result from before the key reads as 0)
 
   /// @brief The parameters of a resolved case configuration.
   static CaseParameters of(const config::CaseConfig& config);

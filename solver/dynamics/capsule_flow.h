@@ -43,7 +43,8 @@ struct FlowEvaluation {
 /// @brief Accumulated wall time of the phases of flow evaluations (exafmm-style named phases).
 /// The boundary integral's total (stokes_s) is split into the SingleLayer phases (SingleLayerStats).
 struct FlowTimings {
-  double membrane_s = 0.0;   ///< kinematics, energy gradient (elastic, and bending when κ_b > 0)
+  double membrane_s = 0.0;   ///< kinematics, elastic energy gradient
+  double bending_s = 0.0;    ///< bending energy gradient with its two mass solves (0 when κ_b = 0)
   double load_s = 0.0;       ///< mass matrix assembly + factorisation + solve
   double stokes_s = 0.0;     ///< boundary integral: the sum of the five phases below
   double layout_s = 0.0;     ///< symmetry check, quadrature points laid out as SoA

@@ -89,6 +89,7 @@ FlowBenchScene measure_scene(CapsuleFlow& flow, const Eigen::Matrix3Xd& x, const
   sc.overhead_ratio = sc.evaluation_ms / sc.regular_sum_ms;
   const double per = 1e3 / repeat;
   sc.membrane_ms = per * (after.membrane_s - before.membrane_s);
+  sc.bending_ms = per * (after.bending_s - before.bending_s);
   sc.load_ms = per * (after.load_s - before.load_s);
   sc.layout_ms = per * (after.layout_s - before.layout_s);
   sc.regular_ms = per * (after.regular_s - before.regular_s);
@@ -98,7 +99,7 @@ FlowBenchScene measure_scene(CapsuleFlow& flow, const Eigen::Matrix3Xd& x, const
   sc.volume_ms = per * (after.volume_s - before.volume_s);
   double mean_eval = 0.0;
   for (double t : eval_ms) mean_eval += t / repeat;
-  sc.other_ms = mean_eval - (sc.membrane_ms + sc.load_ms + sc.layout_ms + sc.regular_ms + sc.far_ms +
+  sc.other_ms = mean_eval - (sc.membrane_ms + sc.bending_ms + sc.load_ms + sc.layout_ms + sc.regular_ms + sc.far_ms +
                              sc.singular_ms + sc.near_ms + sc.volume_ms);
   return sc;
 }
@@ -108,6 +109,10 @@ FlowBenchScene measure_scene(CapsuleFlow& flow, const Eigen::Matrix3Xd& x, const
 bool FlowBenchOptions::valid(std::string* why) const {
   if (level < 1 || level > 6) {
     if (why) *why = "level must be 1..6, got " + std::to_string(level);
+    return false;
+  }
+  if (!(bending_modulus >= 0.0 && bending_modulus <= 1.0)) {
+    if (why) *why = "bending modulus must be in [0, 1], got " + std::to_string(bending_modulus);
     return false;
   }
   if (repeat < 0 || repeat > 100000) {
@@ -124,6 +129,7 @@ FlowBenchReport bench_flow(const FlowBenchOptions& options) {
   c.law = "skalak";
   c.capillary_number = 0.3;
   c.level = options.level;
+  c.bending_modulus = options.bending_modulus;
   CapsuleFlow flow(c);
   FlowBenchReport report;
   report.level = options.level;

@@ -24,6 +24,7 @@ namespace capsim::dynamics {
 struct FlowBenchOptions {
   int level = 3;   ///< mesh level (1..6)
   int repeat = 0;  ///< timed evaluations per scene; 0 = automatic (about a second per scene, 5..400)
+  double bending_modulus = 0.0;  ///< capsule.bending_modulus of the scene (0: the seed's membrane)
   /// @brief Whether the options are usable; if not and why is not null, *why says which and why.
   [[nodiscard]] bool valid(std::string* why = nullptr) const;
 };
@@ -41,6 +42,7 @@ struct FlowBenchScene {
   double overhead_ratio = 0.0;  ///< evaluation_ms / regular_sum_ms
   // Mean time per evaluation of each named phase (CapsuleFlow / SingleLayer timers).
   double membrane_ms = 0.0;     ///< kinematics and energy gradient R = ∂W/∂x
+  double bending_ms = 0.0;      ///< bending energy gradient, its two mass solves included (0 without)
   double load_ms = 0.0;         ///< mass matrix assembly and M q = R
   double layout_ms = 0.0;       ///< symmetry check, quadrature points as SoA
   double regular_ms = 0.0;      ///< regular Stokeslet sum inside the evaluation

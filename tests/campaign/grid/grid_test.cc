@@ -182,6 +182,27 @@ TEST(Grid, CasesTheSolverRejectsAreBadInput) {
   }
 }
 
+// The bending modulus is a grid axis like the others (alias bending_modulus); 0 is the same case as unset.
+TEST(Grid, BendingModulusIsAnAxis) {
+  const auto spec = parse_campaign("[campaign]\nname='b'\n[defaults]\nflow.capillary_number=0.05\n"
+                                   "[[grid]]\nbending_modulus=[0, 1e-3, 1e-2]\n",
+                                   "b.toml");
+  const auto cases = expand_grid(spec);
+  ASSERT_EQ(cases.size(), 3u);
+  CaseParams unset = CaseParams::defaults();
+  unset.set("flow.capillary_number", 0.05);
+  EXPECT_EQ(cases[0].identity("v"), unset.identity("v"));
+  EXPECT_NE(cases[1].identity("v"), cases[0].identity("v"));
+  EXPECT_NE(cases[2].identity("v"), cases[1].identity("v"));
+  EXPECT_NE(cases[2].to_toml().find("bending_modulus = 0.01"), std::string::npos) << cases[2].to_toml();
+  try {
+    (void)parse_campaign("[campaign]\nname='b'\n[[grid]]\nbending_modulus=[-1]\n", "b.toml");
+    ADD_FAILURE() << "a negative bending modulus was accepted";
+  } catch (const BadInput& e) {
+    EXPECT_NE(std::string(e.what()).find("bending_modulus"), std::string::npos) << e.what();
+  }
+}
+
 // [analysis] levels: the grid runs on the scan level; a mesh level given elsewhere contradicts it.
 TEST(Grid, MultiFidelityLevelsSetTheScanLevel) {
   const std::string head = "[campaign]\nname='mf'\n[[grid]]\ncapillary_number=[0.1, 0.2]\n[analysis]\n";

@@ -293,7 +293,7 @@ TEST(SlurmSubmit, BadInputChangesNothing) {
   EXPECT_FALSE(fs::exists(db));
   EXPECT_FALSE(fs::exists(db + ".runs"));
   FakeSlurm f(dir);
-  for (const std::string& bad : {"--time 1h", "--time 01:00:00:00", "--cases-per-task 0", "--array-limit 0",
+  for (const char* bad : {"--time 1h", "--time 01:00:00:00", "--cases-per-task 0", "--array-limit 0",
                                  "--threads-per-job 0", "--partition 'a b'", "--bogus"}) {
     r = sh(f.env() + exe() + " campaign submit " + dir + "/c.toml --db " + db + " " + bad);
     EXPECT_EQ(r.code, 2) << bad << ": " << r.err;

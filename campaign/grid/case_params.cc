@@ -7,6 +7,7 @@
 #include "campaign/grid/sha256.h"
 #include "capsim/version.h"
 #include "solver/config/case_config.h"
+#include "solver/dynamics/time_stepper.h"
 #include "solver/solver_version.h"
 
 namespace capsim::campaign {
@@ -105,7 +106,12 @@ std::string CaseParams::to_toml() const {
 }
 
 double CaseParams::estimated_cost() const {
-  return t_end() * std::pow(2.0, 5.0 * mesh_level()) / std::max(capillary_number(), 1e-6);
+  // Bending stiffness multiplies the RKC stages by sqrt(1 + ρ_b/ρ_el), ρ_b/ρ_el = C_b κ_b/(C_el h²) with the
+  // node spacing h ≈ 0.55 · 2^−level of the sphere mesh (dynamics::membrane_spectral_radius).
+  const double h = 0.55 * std::pow(2.0, -mesh_level());
+  const double bending = std::sqrt(1.0 + dynamics::kBendingSpectralConstant * bending_modulus() /
+                                             (dynamics::kSpectralRadiusConstant * h * h));
+  return bending * t_end() * std::pow(2.0, 5.0 * mesh_level()) / std::max(capillary_number(), 1e-6);
 }
 
 }  // namespace capsim::campaign

@@ -54,7 +54,8 @@ class CaseParams {
   std::string to_json() const;
   /// @brief A case file for `capsim run` (TOML sections).
   std::string to_toml() const;
-  /// @brief Relative cost estimate, for longest-first ordering: t_end * (2^level)^5 / Ca.
+  /// @brief Relative cost estimate, for longest-first ordering: t_end * (2^level)^5 / Ca, times the growth
+  /// of the RKC stages with bending stiffness (see the definition).
   double estimated_cost() const;
 
  private:

@@ -9,23 +9,14 @@
 #include <gtest/gtest.h>
 
 #include "solver/membrane/load_solver.h"
+#include "tests/solver/membrane/deformations.h"
 
 namespace capsim::membrane {
 namespace {
 
 using Eigen::Matrix3Xd;
 
-// A smooth, large, non-affine deformation of the reference.
-Matrix3Xd smooth_deformation(const Matrix3Xd& X, double amp) {
-  Matrix3Xd x = X;
-  for (int i = 0; i < X.cols(); ++i) {
-    const double a = X(0, i), b = X(1, i), c = X(2, i);
-    x(0, i) += amp * (0.3 * a + std::sin(1.3 * b + 0.2) * c);
-    x(1, i) += amp * (-0.2 * b + std::cos(0.7 * a) * 0.4);
-    x(2, i) += amp * (0.25 * c * a + 0.1 * std::sin(2.0 * b));
-  }
-  return x;
-}
+using testing::smooth_deformation;
 
 TEST(AreaVolume, SphereConvergesUnderRefinement) {
   double prev_a = 0, prev_v = 0;

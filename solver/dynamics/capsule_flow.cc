@@ -132,11 +132,18 @@ double automatic_time_step(const mesh::SurfaceMesh& mesh, double capillary_numbe
 
 double automatic_time_step(const config::CaseConfig& config, const mesh::SurfaceMesh& mesh) {
   double stable = automatic_time_step(mesh, config.capillary_number, config.dt_factor);
-  if (config.bending_modulus > 0.0) {
-    const double h = mesh::min_node_spacing(mesh, mesh.nodes);
-    stable /= 1.0 + kBendingSpectralConstant * config.bending_modulus / (kSpectralRadiusConstant * h * h);
-  }
-  return config.scheme == "rkc" ? std::max(config.dt_accuracy, stable) : stable;
+  if (config.bending_modulus <= 0.0) return config.scheme == "rkc" ? std::max(config.dt_accuracy, stable) : stable;
+  const double h = mesh::min_node_spacing(mesh, mesh.nodes);
+  stable /= 1.0 + kBendingSpectralConstant * config.bending_modulus / (kSpectralRadiusConstant * h * h);
+  if (config.scheme != "rkc") return stable;
+  // A stiff bending membrane on a fine mesh can need more stages than RKC allows at the accuracy step
+  // (level 4, κ_b = 0.1: ≈ 600): cap dt so the reference state needs at most half of them, leaving room for
+  // the prestress and the shrinking h_min of the deformed states.
+  const RkcIntegrator::Options rkc;
+  const double rho = config.rkc_safety * membrane_spectral_radius(mesh, mesh.nodes, config.capillary_number, 0.0,
+                                                                   config.bending_modulus);
+  const double cap = RkcIntegrator::stability_boundary(rkc.max_stages / 2, rkc.damping) / rho;
+  return std::min(std::max(config.dt_accuracy, stable), cap);
 }
 
 }  // namespace capsim::dynamics

@@ -133,7 +133,9 @@ inline constexpr double kLargeCaCoefficient = 0.75;
 /// dt (at large Ca the stiffness is mild and the rk2 step is already accurate). With bending stiffness the rk2
 /// dt shrinks by the ratio of the elastic to the total stiffness at the reference,
 /// 1 / (1 + kBendingSpectralConstant κ_b / (kSpectralRadiusConstant h_min²)) (time_stepper.h): rk2 must stay
-/// stable, rkc keeps its accuracy step and takes the stages the stiffness needs.
+/// stable, rkc keeps its accuracy step and takes the stages the stiffness needs — at most half of
+/// RkcIntegrator::Options::max_stages on the reference state (dt is capped below the accuracy step where
+/// that would be exceeded).
 double automatic_time_step(const config::CaseConfig& config, const mesh::SurfaceMesh& mesh);
 
 }  // namespace capsim::dynamics

@@ -271,5 +271,37 @@ TEST(Rkc, RefusesTooManyStagesWithStepRejected) {
   EXPECT_TRUE(x == x0);
 }
 
+// With bending the automatic rkc step stays the accuracy step while the stages allow it, and is capped so
+// that the reference state needs at most half of max_stages where they would not (level 4, κ_b = 0.1);
+// without bending it is what it always was.
+TEST(Rkc, AutomaticStepKeepsTheStagesWithinReachUnderBending) {
+  config::CaseConfig c;
+  c.aspect_ratio = 0.5;
+  c.capillary_number = 0.05;
+  const RkcIntegrator::Options rkc;
+  for (int level : {2, 4}) {
+    c.level = level;
+    const auto mesh = mesh::make_capsule_mesh(level, c.aspect_ratio);
+    c.bending_modulus = 0.0;
+    EXPECT_EQ(automatic_time_step(c, mesh),
+              std::max(c.dt_accuracy, automatic_time_step(mesh, c.capillary_number, c.dt_factor)));
+    for (double kb : {1e-3, 1e-1}) {
+      c.bending_modulus = kb;
+      const double dt = automatic_time_step(c, mesh);
+      const double rho = c.rkc_safety * membrane_spectral_radius(mesh, mesh.nodes, c.capillary_number, 0.0, kb);
+      const int stages = RkcIntegrator::stages_for(dt * rho, rkc.damping);
+      std::printf("level %d κ_b %g: dt %.4g, %d stages at the reference\n", level, kb, dt, stages);
+      EXPECT_LE(stages, rkc.max_stages / 2 + 1);
+      EXPECT_LE(dt, c.dt_accuracy);
+      if (level == 2) {
+        EXPECT_EQ(dt, c.dt_accuracy) << "no cap needed on level 2";
+      }
+    }
+  }
+  c.level = 4;
+  c.bending_modulus = 0.1;
+  EXPECT_LT(automatic_time_step(c, mesh::make_capsule_mesh(4, c.aspect_ratio)), c.dt_accuracy) << "capped";
+}
+
 }  // namespace
 }  // namespace capsim::dynamics

@@ -127,6 +127,16 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
   return out;
 }
 
+int bisections_saved(const Transition& t, double ca_tolerance) {
+  auto saved = [&](const std::optional<double>& a, const std::optional<double>& b) {
+    if (!a || !b || !(ca_tolerance > 0)) return 0;
+    const double width = std::abs(*b - *a);
+    return width > ca_tolerance ? static_cast<int>(std::ceil(std::log2(width / ca_tolerance) - 1e-12)) : 0;
+  };
+  return saved(t.ca_star_below, t.ca_star_low) + saved(t.ca_star_high, t.ca_star_above) +
+         saved(t.ca_h_low, t.ca_h_high);
+}
+
 std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,
                                           int budget) {
   std::vector<CaseParams> out;

@@ -43,6 +43,12 @@ struct MultiFidelityOptions {
 std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,
                                            int budget);
 
+/// @brief The bisections adaptive refinement did not make because it stopped at the numerical error: for each
+/// bracket of @p t (both Ca* edges, CaH) that is wider than @p ca_tolerance, ceil(log2(width / ca_tolerance))
+/// — the cases a refinement down to ca_tolerance alone would still have run (issue 14 §2, "report the cases
+/// saved"). 0 for a missing bracket.
+int bisections_saved(const Transition& t, double ca_tolerance);
+
 /// @brief Phase 5: the final brackets of the answer level on the check level (levels[2]; none without one).
 std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,
                                           int budget);

@@ -438,6 +438,15 @@ int run_campaign(const RunOptions& opt, const BeforeRun& before_run) {
       cost += " level " + std::to_string(l.mesh_level) + " " + std::to_string(l.finished) + "/" +
               std::to_string(l.cases) + " (" + format_significant(l.core_s / 3600.0, 3) + " h);";
     std::fprintf(stderr, "%s\n", cost.c_str());
+    if (spec.analysis.adaptive) {
+      int saved = 0;
+      for (const auto& t : store->transitions(campaign_id))
+        if (t.role == "answer") saved += bisections_saved(t, spec.analysis.ca_tolerance);
+      std::fprintf(stderr,
+                   "capsim campaign: stopping each bracket at its numerical error saved %d answer-level case(s) "
+                   "(the bisections down to ca_tolerance = %s)\n",
+                   saved, format_significant(spec.analysis.ca_tolerance, 3).c_str());
+    }
   }
   if (!completed) {
     std::fprintf(stderr, "capsim campaign: interrupted; the database is consistent. Rerun the same command to resume.\n");

@@ -146,5 +146,20 @@ TEST(MultiFidelity, TheDtCheckHalvesTheStepOfTheCaHLowCase) {
   EXPECT_TRUE(answer_level_round(group_cases(cases), MultiFidelityOptions{{2, 3}, 0.05, 0.005, false}, 100).empty());
 }
 
+TEST(MultiFidelity, BisectionsSavedCountsWhatRefinementToTheToleranceWouldStillRun) {
+  Transition t;
+  EXPECT_EQ(bisections_saved(t, 0.005), 0) << "no bracket, nothing saved";
+  t.ca_h_low = 0.5;
+  t.ca_h_high = 0.54;  // 0.04 / 0.005 = 8: three more halvings
+  EXPECT_EQ(bisections_saved(t, 0.005), 3);
+  t.ca_star_below = 0.02;
+  t.ca_star_low = 0.025;  // already at the tolerance: none
+  t.ca_star_high = 0.05;
+  t.ca_star_above = 0.06;  // 0.01 / 0.005 = 2: one
+  EXPECT_EQ(bisections_saved(t, 0.005), 4);
+  t.ca_h_high = 0.541;  // 8.2: four
+  EXPECT_EQ(bisections_saved(t, 0.005), 5);
+}
+
 }  // namespace
 }  // namespace capsim::campaign

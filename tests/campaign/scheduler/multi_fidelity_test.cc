@@ -35,6 +35,10 @@ max_rounds = 20
   EXPECT_NE(r.err.find("mesh check on level 3"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("dt/2 check on level 2"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("cases per mesh level"), std::string::npos) << r.err;
+  // CaH's level-2 answer is bracketed to ≈ its error 0.2, not to ca_tolerance: bisections were saved.
+  const auto saved_at = r.err.find("numerical error saved ");
+  ASSERT_NE(saved_at, std::string::npos) << r.err;
+  EXPECT_GT(std::stoi(r.err.substr(saved_at + std::string("numerical error saved ").size())), 0) << r.err;
 
   auto rows = nlohmann::json::parse(
       sh(exe() + " query sql \"SELECT mesh_level, role, method, ca_h, ca_h_low, ca_h_high, ca_h_err, ca_h_err_source, "

@@ -1,10 +1,10 @@
 #include "solver/dynamics/capsule_flow.h"
 
-#include "solver/dynamics/time_stepper.h"
-
 #include <algorithm>
 #include <chrono>
 #include <numbers>
+
+#include "solver/dynamics/time_stepper.h"
 
 
 namespace capsim::dynamics {

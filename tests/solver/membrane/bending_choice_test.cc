@@ -19,6 +19,7 @@
 
 #include "solver/membrane/bending.h"
 #include "solver/mesh/p2_tabulation.h"
+#include "tests/solver/membrane/deformations.h"
 
 namespace capsim::membrane {
 namespace {
@@ -73,16 +74,7 @@ class HingeEnergy {
   std::vector<double> ref_angle_;
 };
 
-double legendre(int l, double t) {
-  double p0 = 1.0, p1 = t;
-  if (l == 0) return p0;
-  for (int k = 2; k <= l; ++k) {
-    const double p2 = ((2 * k - 1) * t * p1 - (k - 1) * p0) / k;
-    p0 = p1;
-    p1 = p2;
-  }
-  return p1;
-}
+using testing::legendre;
 
 TEST(BendingChoice, HelfrichConvergesForEveryModeAndTheHingeEnergyDoesNot) {
   const double kb = 1.0, eps = 1e-3;

@@ -122,17 +122,7 @@ TEST(Bending, InflatedSphereEnergyConvergesToTheClosedForm) {
   }
 }
 
-// Legendre polynomial P_l(t).
-double legendre(int l, double t) {
-  double p0 = 1.0, p1 = t;
-  if (l == 0) return p0;
-  for (int k = 2; k <= l; ++k) {
-    const double p2 = ((2 * k - 1) * t * p1 - (k - 1) * p0) / k;
-    p0 = p1;
-    p1 = p2;
-  }
-  return p1;
-}
+using testing::legendre;
 
 TEST(Bending, PerturbedSphereLoadConvergesToTheClosedForm) {
   // x = X (1 + ε Y_l), Y_l = P_l(e·X) about an axis e not aligned with the mesh: the linearised load

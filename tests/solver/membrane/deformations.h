@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief Test deformations shared by the membrane tests (elastic laws and bending).
+/// @brief Test deformations and modes shared by the membrane tests (elastic laws and bending).
 
 #include <cmath>
 
@@ -18,6 +18,18 @@ inline Eigen::Matrix3Xd smooth_deformation(const Eigen::Matrix3Xd& X, double amp
     x(2, i) += amp * (0.25 * c * a + 0.1 * std::sin(2.0 * b));
   }
   return x;
+}
+
+/// @brief Legendre polynomial P_l(t) (three-term recurrence): axisymmetric spherical harmonics about any axis.
+inline double legendre(int l, double t) {
+  double p0 = 1.0, p1 = t;
+  if (l == 0) return p0;
+  for (int k = 2; k <= l; ++k) {
+    const double p2 = ((2 * k - 1) * t * p1 - (k - 1) * p0) / k;
+    p0 = p1;
+    p1 = p2;
+  }
+  return p1;
 }
 
 }  // namespace capsim::membrane::testing

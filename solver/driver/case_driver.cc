@@ -114,6 +114,10 @@ class CaseRun {
       p_node_ = static_cast<int>(cp.scalars["p_node"]);
       wrinkle_max_.compressed_area_fraction = cp.scalars["max_compressed_area_fraction"];
       wrinkle_max_.load_roughness = cp.scalars["max_load_roughness"];
+      // The cost of the invocations before (absent in checkpoints from before they were kept: 0), so that a
+      // resumed case reports what the uninterrupted one would (the campaigns' core-hours rest on it).
+      evaluations_before_ = static_cast<long>(cp.scalars["flow_evaluations"]);
+      wall_before_ = cp.scalars["wall_s"];
       writer_.emplace(io::CaseWriter::resume(case_file_, case_attributes(config_), series_));
     } else {
       writer_.emplace(case_file_, case_attributes(config_));
@@ -269,7 +273,7 @@ class CaseRun {
     r_.dt = dt_;
     r_.steps = step_;
     r_.t_final = t_;
-    r_.flow_evaluations = flow_->timings().evaluations;
+    r_.flow_evaluations = evaluations_before_ + flow_->timings().evaluations;
     r_.membrane_s = flow_->timings().membrane_s + flow_->timings().bending_s;  // elastic + bending
     r_.load_s = flow_->timings().load_s;
     r_.stokes_s = flow_->timings().stokes_s;
@@ -279,10 +283,10 @@ class CaseRun {
   // --- Output: the final checkpoint of a finished case and the summary as the case file's attributes.
   void output() {
     if (r_.status == "done") save_checkpoint();
-    r_.wall_s = std::chrono::duration<double>(Clock::now() - wall0_).count();
+    r_.wall_s = wall_before_ + std::chrono::duration<double>(Clock::now() - wall0_).count();
     for (const auto& a : summary_attributes(CaseSummary::of(config_, r_))) writer_->set_attribute(a);
     writer_->close();
-    r_.wall_s = std::chrono::duration<double>(Clock::now() - wall0_).count();
+    r_.wall_s = wall_before_ + std::chrono::duration<double>(Clock::now() - wall0_).count();
   }
 
   void save_checkpoint() {
@@ -295,6 +299,8 @@ class CaseRun {
     cp.scalars["p_node"] = p_node_;
     cp.scalars["max_compressed_area_fraction"] = wrinkle_max_.compressed_area_fraction;
     cp.scalars["max_load_roughness"] = wrinkle_max_.load_roughness;
+    cp.scalars["flow_evaluations"] = static_cast<double>(evaluations_before_ + flow_->timings().evaluations);
+    cp.scalars["wall_s"] = wall_before_ + std::chrono::duration<double>(Clock::now() - wall0_).count();
     cp.strings["case"] = identity_;
     io::write_checkpoint(checkpoint_file_, cp);
   }
@@ -334,6 +340,8 @@ class CaseRun {
   Eigen::Matrix3Xd x_;
   double t_ = 0.0;
   long step_ = 0;
+  long evaluations_before_ = 0;  // flow evaluations and wall time of the invocations before a resume
+  double wall_before_ = 0.0;
   diagnostics::TimeSeries series_;
   int p_node_ = 0;
   bool keep_mirror_ = false;  // the state started mirror-symmetric: keep it exactly so (restore_or_start)

@@ -101,6 +101,9 @@ TEST(RunCommand, ResumeAfterInterruptionMatchesUninterruptedRun) {
   const auto ja = last_json_line(full.out), jb = last_json_line(rest.out);
   EXPECT_EQ(ja["steps"], jb["steps"]);
   EXPECT_EQ(ja["volume_drift"], jb["volume_drift"]);
+  // The resumed run reports the whole case's cost, not only its own part's.
+  EXPECT_EQ(ja["flow_evaluations"], jb["flow_evaluations"]);
+  EXPECT_GT(jb["wall_s"].get<double>(), last_json_line(part.out)["wall_s"].get<double>());
 }
 
 TEST(RunCommand, ResumeRefusesACheckpointOfAnotherCase) {

@@ -272,6 +272,7 @@ TEST(CaseDriver, BendingRunIsStableRecordedAndResumesBitwise) {
   o.resume = true;
   const CaseResult resumed = run_case(c, o);
   EXPECT_EQ(resumed.steps, full.steps);
+  EXPECT_EQ(resumed.flow_evaluations, full.flow_evaluations) << "the cost of both invocations";
   EXPECT_TRUE(io::read_case_file(rdir / "case.h5").series == series);
 }
 

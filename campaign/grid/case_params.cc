@@ -109,8 +109,7 @@ double CaseParams::estimated_cost() const {
   // Bending stiffness multiplies the RKC stages by sqrt(1 + ρ_b/ρ_el), ρ_b/ρ_el = C_b κ_b/(C_el h²) with the
   // node spacing h ≈ 0.55 · 2^−level of the sphere mesh (dynamics::membrane_spectral_radius).
   const double h = 0.55 * std::pow(2.0, -mesh_level());
-  const double bending = std::sqrt(1.0 + dynamics::kBendingSpectralConstant * bending_modulus() /
-                                             (dynamics::kSpectralRadiusConstant * h * h));
+  const double bending = std::sqrt(1.0 + dynamics::bending_stiffness_ratio(bending_modulus(), h));
   return bending * t_end() * std::pow(2.0, 5.0 * mesh_level()) / std::max(capillary_number(), 1e-6);
 }
 

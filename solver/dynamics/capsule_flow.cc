@@ -44,22 +44,18 @@ membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Ei
   membrane::MembraneState s = mechanics_->evaluate(x);
   timings_.membrane_s += seconds_since(t0);
   t0 = std::chrono::steady_clock::now();
-  if (!bending_) {
-    try {
-      load_solver_->compute_load(x, s.internal_force, q);
-    } catch (const std::runtime_error& e) {
-      throw membrane::DegenerateSurface(e.what());
-    }
-    timings_.load_s += seconds_since(t0);
-    return s;
-  }
   // With bending: its evaluation factorises the mass matrix on x (its two mass solves need it), and the
   // load solve reuses that factorisation for M q = R_elastic + R_b.
-  bending_state_ = bending_->evaluate(x, *load_solver_);
-  timings_.bending_s += seconds_since(t0);
-  t0 = std::chrono::steady_clock::now();
+  if (bending_) {
+    bending_state_ = bending_->evaluate(x, *load_solver_);
+    timings_.bending_s += seconds_since(t0);
+    t0 = std::chrono::steady_clock::now();
+  }
   try {
-    load_solver_->solve(s.internal_force + bending_state_.internal_force, q);
+    if (bending_)
+      load_solver_->solve(s.internal_force + bending_state_.internal_force, q);
+    else
+      load_solver_->compute_load(x, s.internal_force, q);
   } catch (const std::runtime_error& e) {
     throw membrane::DegenerateSurface(e.what());
   }
@@ -134,7 +130,7 @@ double automatic_time_step(const config::CaseConfig& config, const mesh::Surface
   double stable = automatic_time_step(mesh, config.capillary_number, config.dt_factor);
   if (config.bending_modulus <= 0.0) return config.scheme == "rkc" ? std::max(config.dt_accuracy, stable) : stable;
   const double h = mesh::min_node_spacing(mesh, mesh.nodes);
-  stable /= 1.0 + kBendingSpectralConstant * config.bending_modulus / (kSpectralRadiusConstant * h * h);
+  stable /= 1.0 + bending_stiffness_ratio(config.bending_modulus, h);
   if (config.scheme != "rkc") return stable;
   // A stiff bending membrane on a fine mesh can need more stages than RKC allows at the accuracy step
   // (level 4, κ_b = 0.1: ≈ 600): cap dt so the reference state needs at most half of them, leaving room for

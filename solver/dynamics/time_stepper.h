@@ -157,6 +157,13 @@ inline constexpr double kSpectralRadiusConstant = 6.5;
 inline constexpr double kPrestressCoefficient = 0.4;
 inline constexpr double kBendingSpectralConstant = 45.0;
 
+/// @brief ρ_bending / ρ_elastic of the estimate above at node spacing h without prestress:
+/// kBendingSpectralConstant κ_b / (kSpectralRadiusConstant h²). The one place the automatic dt and the
+/// campaign's cost estimate take the bending stiffness from.
+inline double bending_stiffness_ratio(double bending_modulus, double h) {
+  return kBendingSpectralConstant * bending_modulus / (kSpectralRadiusConstant * h * h);
+}
+
 /// @brief Power-iteration estimate of the spectral radius of J = ∂v/∂x at x (finite differences of v,
 /// `iterations` flow evaluations plus one). For tests and calibration; the mirror symmetry of a symmetric
 /// scene is kept by symmetrising the iterate, so the estimate is over the modes the run can excite.

@@ -97,7 +97,9 @@ int campaign_command(const std::vector<std::string>& args) {
   run->add_flag("--dry-run", opt.dry_run, "list what would run and why, change nothing");
   run->add_flag("--retry-failed", opt.retry_failed, "run failed cases again");
   run->add_option("--runs-dir", opt.runs_dir, "folder of the case folders (default: DB.runs)");
-  run->add_option("--order", opt.order, "longest (estimated cost first, default) or grid");
+  run->add_option("--order", opt.order,
+                  "longest (estimated cost first, default), shortest (cheapest first: the most answers before an "
+                  "interruption) or grid (file order)");
   run->add_option("--grace", opt.grace_s, "seconds workers get to checkpoint after SIGINT/SIGTERM (default 120)");
   run->add_option("--worker", opt.worker, "worker executable (default: $CAPSIM_WORKER, else this capsim)")
       ->group("");  // hidden: for tests and alternative workers

@@ -24,7 +24,7 @@ struct RunOptions {
   bool dry_run = false;        ///< list what would run and why; writes nothing
   bool retry_failed = false;   ///< requeue failed cases
   std::string worker;          ///< worker executable (default $CAPSIM_WORKER or this program)
-  std::string order = "longest";  ///< "longest" (estimated cost first) or "grid" (file order)
+  std::string order = "longest";  ///< "longest" (estimated cost first), "shortest" (cheapest first) or "grid" (file order)
   double grace_s = 120;        ///< after forwarding a stop signal, SIGKILL workers still alive after this
 };
 

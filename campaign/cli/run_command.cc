@@ -107,9 +107,11 @@ int run_command(const std::vector<std::string>& args) {
                  a.mean_D12, r.volume_drift);
     std::fprintf(stderr, "# phases: membrane %.1f s, load %.1f s, boundary integral %.1f s\n", r.membrane_s, r.load_s,
                  r.stokes_s);
-    std::fprintf(stderr, "# wrinkle indicators (final / largest sampled): compressed area %.3f / %.3f, q.n roughness %.3f / %.3f\n",
+    std::fprintf(stderr,
+                 "# wrinkle indicators (final / largest sampled): compressed area %.3f / %.3f, q.n roughness %.3f / "
+                 "%.3f; wrinkle wavelength (final) %.3g\n",
                  r.wrinkle_final.compressed_area_fraction, r.wrinkle_max.compressed_area_fraction,
-                 r.wrinkle_final.load_roughness, r.wrinkle_max.load_roughness);
+                 r.wrinkle_final.load_roughness, r.wrinkle_max.load_roughness, r.wrinkle_final.wrinkle_wavelength);
   }
   if (json) {
     const nlohmann::json j = driver::CaseSummary::of(config, r).to_json();

@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/Sparse>
 
 #include "solver/mesh/p2_tabulation.h"
 
@@ -51,6 +55,73 @@ double load_roughness(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x, 
     sum_q2 += qn[i] * qn[i];
   }
   return sum_q2 > 0 ? std::sqrt(sum_d2 / sum_q2) : 0.0;
+}
+
+WrinkleWavelength::WrinkleWavelength(const mesh::SurfaceMesh& mesh, Options options)
+    : mesh_(mesh), options_(options), p2_(mesh::P2Tabulation::of_degree(6)) {
+  if (!options.valid()) throw std::invalid_argument("WrinkleWavelength: filter_length > 0 and 1 <= filter_order <= 16");
+}
+
+WrinkleWavelength::WrinkleWavelength(const mesh::SurfaceMesh& mesh) : WrinkleWavelength(mesh, Options{}) {}
+
+double WrinkleWavelength::operator()(const Eigen::Matrix3Xd& x) const {
+  const int ne = mesh_.num_elements(), nq = p2_.size(), nn = mesh_.num_nodes();
+  if (x.cols() != nn) throw std::invalid_argument("WrinkleWavelength: x needs one column per node");
+  // Assemble: M_ab = ∫ φ_a φ_b dS, Ks_ab = ∫ ∇s φ_a · ∇s φ_b dS = Σ w J ∂_α φ_a g^{αβ} ∂_β φ_b.
+  std::vector<Eigen::Triplet<double>> tm, tk;
+  tm.reserve(static_cast<std::size_t>(ne) * 36);
+  tk.reserve(static_cast<std::size_t>(ne) * 36);
+  for (int e = 0; e < ne; ++e) {
+    const auto& el = mesh_.elements[e];
+    double me[6][6] = {}, ke[6][6] = {};
+    for (int q = 0; q < nq; ++q) {
+      const auto t = p2_.tangents(x, el, q);
+      const double g11 = t.g1.dot(t.g1), g12 = t.g1.dot(t.g2), g22 = t.g2.dot(t.g2);
+      const double det = g11 * g22 - g12 * g12;
+      if (!(det > 0.0) || !std::isfinite(det)) return std::nan("");  // collapsed: no wavelength
+      const double w = p2_.weight(q) * std::sqrt(det);
+      const mesh::P2Point& p = p2_[q];
+      for (int a = 0; a < 6; ++a) {
+        const double u1 = (g22 * p.dxi[a] - g12 * p.deta[a]) / det, u2 = (g11 * p.deta[a] - g12 * p.dxi[a]) / det;
+        for (int b = 0; b < 6; ++b) {
+          me[a][b] += w * p.n[a] * p.n[b];
+          ke[a][b] += w * (u1 * p.dxi[b] + u2 * p.deta[b]);
+        }
+      }
+    }
+    for (int a = 0; a < 6; ++a)
+      for (int b = 0; b < 6; ++b) {
+        tm.emplace_back(el[a], el[b], me[a][b]);
+        tk.emplace_back(el[a], el[b], ke[a][b]);
+      }
+  }
+  Eigen::SparseMatrix<double> M(nn, nn), K(nn, nn);
+  M.setFromTriplets(tm.begin(), tm.end());
+  K.setFromTriplets(tk.begin(), tk.end());
+  // High-pass: y ← (M + t Ks)⁻¹ t Ks y, m times (each coordinate).
+  const double t = options_.filter_length * options_.filter_length;
+  const Eigen::SparseMatrix<double> A = M + t * K;
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
+  cg.setTolerance(1e-10);
+  cg.compute(A);
+  Eigen::MatrixXd y = x.transpose();
+  for (int k = 0; k < options_.filter_order; ++k) {
+    const Eigen::MatrixXd rhs = t * (K * y);
+    y = cg.solve(rhs);
+    if (cg.info() != Eigen::Success) return std::nan("");
+  }
+  // Normal relief, mean removed; the Rayleigh quotient of −Δs.
+  const Eigen::Matrix3Xd normals = mesh::node_normals(mesh_, x);
+  Eigen::VectorXd u(nn);
+  for (int i = 0; i < nn; ++i) u[i] = normals.col(i).dot(y.row(i).transpose());
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(nn);
+  const Eigen::VectorXd m_ones = M * ones;
+  u.array() -= u.dot(m_ones) / ones.dot(m_ones);
+  const double a0 = u.dot(M * u), b0 = u.dot(K * u);
+  // Relief below round-off of the positions (relative 1e-13 of the size): none to measure.
+  const double size2 = ones.dot(m_ones) * (x.rowwise().maxCoeff() - x.rowwise().minCoeff()).squaredNorm();
+  if (!(a0 > 1e-26 * size2) || !(b0 > 0)) return std::nan("");
+  return 2.0 * std::numbers::pi * std::sqrt(a0 / b0);
 }
 
 }  // namespace capsim::diagnostics

@@ -87,5 +87,46 @@ max_rounds = 20
   EXPECT_EQ(sh(exe() + " query sql \"SELECT count(*) AS n FROM cases\" --db " + db + " --format json").out, before);
 }
 
+// The honesty check of issue 14 §4 (scripts/table1 --error-check): the answer of a two-level campaign
+// (levels 1–2) with its error, against the value a third level gives (levels 1–2–3). Fake CaH of level L:
+// 0.699 − 0.8 · 2^-L, so level 2 says 0.499 ± 0.2 (the level 1 → 2 difference) and level 3 gives 0.599: within,
+// half an error off. With the answer shifted by more than its error the check must say so.
+TEST(MultiFidelity, ErrorCheckPlacesTheFinerLevelAgainstTheTwoLevelErrorBar) {
+  const std::string dir = fresh_dir("multi_fidelity_error_check");
+  const std::string grid = R"([[grid]]
+aspect_ratio = [0.5]
+law = ["neo-hookean"]
+capillary_number = [0.01, 0.02, 0.03, 0.04, 0.05, 0.1, 0.4, 0.8, 1.2]
+[analysis]
+adaptive = true
+ca_tolerance = 0.005
+max_rounds = 20
+)";
+  write_file(dir + "/two.toml", "[campaign]\nname = \"two\"\n" + grid + "levels = [1, 2]\n");
+  write_file(dir + "/three.toml", "[campaign]\nname = \"three\"\n" + grid + "levels = [1, 2, 3]\n");
+  const std::string env = "FAKE_STEPS=1 FAKE_STEP_S=0.001 FAKE_LEVEL_SHIFT=0.8";
+  ASSERT_EQ(sh(campaign_cmd(env, dir + "/two.toml", dir + "/two.db", "--jobs 2")).code, 0);
+  ASSERT_EQ(sh(campaign_cmd(env, dir + "/three.toml", dir + "/three.db", "--jobs 2")).code, 0);
+  auto q = sh(exe() + " query table1 --db " + dir + "/two.db --format json");
+  ASSERT_EQ(q.code, 0) << q.err;
+  write_file(dir + "/two.json", q.out);
+  const std::string table1 = "/usr/bin/python3 " + std::string(CAPSIM_SOURCE_DIR) + "/scripts/table1";
+  auto r = sh(table1 + " --db " + dir + "/three.db --error-check " + dir + "/two.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("| CaH | 0.5 ± 0.2 (1,2) | 0.60 | 0.50 errors | within |"), std::string::npos) << r.out;
+  // The fake's Ca* edges do not move with the level: the crossing 0.015 lies at the edge of 0.018 ± 0.003.
+  EXPECT_NE(r.out.find("3 of 3 level-3 values lie within"), std::string::npos) << r.out;
+  // The same check against a coarse CaH moved down by 0.35: (0.599 − 0.149) / 0.2 = 2.25 errors, outside.
+  auto moved = nlohmann::json::parse(q.out);
+  moved[0]["ca_h"] = moved[0]["ca_h"].get<double>() - 0.35;
+  write_file(dir + "/moved.json", moved.dump());
+  r = sh(table1 + " --db " + dir + "/three.db --error-check " + dir + "/moved.json");
+  EXPECT_NE(r.out.find("2.25 errors | **outside** |"), std::string::npos) << r.out;
+  // Without a finer level there is nothing to check, and it says so.
+  r = sh(table1 + " --db " + dir + "/two.db --error-check " + dir + "/two.json");
+  EXPECT_NE(r.out.find("nothing to check"), std::string::npos) << r.out;
+  EXPECT_EQ(sh(table1 + " --json " + dir + "/two.json --error-check " + dir + "/two.json").code, 2);
+}
+
 }  // namespace
 }  // namespace capsim::campaign::testing

@@ -64,7 +64,7 @@ WrinkleWavelength::WrinkleWavelength(const mesh::SurfaceMesh& mesh, Options opti
 
 WrinkleWavelength::WrinkleWavelength(const mesh::SurfaceMesh& mesh) : WrinkleWavelength(mesh, Options{}) {}
 
-double WrinkleWavelength::operator()(const Eigen::Matrix3Xd& x) const {
+WrinkleWavelength::Relief WrinkleWavelength::measure(const Eigen::Matrix3Xd& x) const {
   const int ne = mesh_.num_elements(), nq = p2_.size(), nn = mesh_.num_nodes();
   if (x.cols() != nn) throw std::invalid_argument("WrinkleWavelength: x needs one column per node");
   // Assemble: M_ab = ∫ φ_a φ_b dS, Ks_ab = ∫ ∇s φ_a · ∇s φ_b dS = Σ w J ∂_α φ_a g^{αβ} ∂_β φ_b.
@@ -78,7 +78,7 @@ double WrinkleWavelength::operator()(const Eigen::Matrix3Xd& x) const {
       const auto t = p2_.tangents(x, el, q);
       const double g11 = t.g1.dot(t.g1), g12 = t.g1.dot(t.g2), g22 = t.g2.dot(t.g2);
       const double det = g11 * g22 - g12 * g12;
-      if (!(det > 0.0) || !std::isfinite(det)) return std::nan("");  // collapsed: no wavelength
+      if (!(det > 0.0) || !std::isfinite(det)) return {};  // collapsed: no wavelength
       const double w = p2_.weight(q) * std::sqrt(det);
       const mesh::P2Point& p = p2_[q];
       for (int a = 0; a < 6; ++a) {
@@ -108,7 +108,7 @@ double WrinkleWavelength::operator()(const Eigen::Matrix3Xd& x) const {
   for (int k = 0; k < options_.filter_order; ++k) {
     const Eigen::MatrixXd rhs = t * (K * y);
     y = cg.solve(rhs);
-    if (cg.info() != Eigen::Success) return std::nan("");
+    if (cg.info() != Eigen::Success) return {};
   }
   // Normal relief, mean removed; the Rayleigh quotient of −Δs.
   const Eigen::Matrix3Xd normals = mesh::node_normals(mesh_, x);
@@ -120,8 +120,9 @@ double WrinkleWavelength::operator()(const Eigen::Matrix3Xd& x) const {
   const double a0 = u.dot(M * u), b0 = u.dot(K * u);
   // Relief below round-off of the positions (relative 1e-13 of the size): none to measure.
   const double size2 = ones.dot(m_ones) * (x.rowwise().maxCoeff() - x.rowwise().minCoeff()).squaredNorm();
-  if (!(a0 > 1e-26 * size2) || !(b0 > 0)) return std::nan("");
-  return 2.0 * std::numbers::pi * std::sqrt(a0 / b0);
+  if (!(a0 > 1e-26 * size2) || !(b0 > 0)) return {};
+  const double area = ones.dot(m_ones);
+  return {2.0 * std::numbers::pi * std::sqrt(a0 / b0), std::sqrt(a0 / area)};
 }
 
 }  // namespace capsim::diagnostics

@@ -46,6 +46,7 @@ struct WrinkleIndicators {
   double compressed_area_fraction = 0;  ///< share of the area with τ2 < 0 (0 … 1)
   double load_roughness = 0;            ///< RMS(q·n − neighbour mean) / RMS(q·n) (0 for a uniform q·n)
   double wrinkle_wavelength = std::numeric_limits<double>::quiet_NaN();  ///< λ (WrinkleWavelength); NaN: none
+  double wrinkle_amplitude = std::numeric_limits<double>::quiet_NaN();   ///< RMS of the filtered relief u
 };
 
 /// @brief Share of the current area where the smaller principal tension is negative.
@@ -75,10 +76,19 @@ class WrinkleWavelength {
   /// @throws std::invalid_argument unless options.valid().
   WrinkleWavelength(const mesh::SurfaceMesh& mesh, Options options);
   explicit WrinkleWavelength(const mesh::SurfaceMesh& mesh);
-  /// @brief λ = 2π / k on x; NaN if the filtered relief vanishes (a sphere: its relief is constant) or an
-  /// element of x is collapsed.
+  /// @brief The wavelength and the amplitude of the relief it measures.
+  struct Relief {
+    double wavelength = std::numeric_limits<double>::quiet_NaN();  ///< λ = 2π / k
+    double amplitude = std::numeric_limits<double>::quiet_NaN();   ///< RMS of u over the area (units of ℓ)
+  };
+  /// @brief λ and the RMS relief on x; NaN if the filtered relief vanishes or an element of x is collapsed.
+  /// The amplitude tells wrinkles from nothing: a wave of amplitude A and wavenumber k shows as
+  /// A (t k²/(1 + t k²))^m, the filtered remains of a smooth shape and the discretisation's own relief are
+  /// orders smaller (measured in results/bending/README.md), and λ of a relief that small is the mesh's.
   /// @throws std::invalid_argument if x does not have one column per node.
-  [[nodiscard]] double operator()(const Eigen::Matrix3Xd& x) const;
+  [[nodiscard]] Relief measure(const Eigen::Matrix3Xd& x) const;
+  /// @brief measure(x).wavelength.
+  [[nodiscard]] double operator()(const Eigen::Matrix3Xd& x) const { return measure(x).wavelength; }
 
  private:
   const mesh::SurfaceMesh& mesh_;

@@ -52,7 +52,9 @@ std::optional<diagnostics::WrinkleIndicators> measure_wrinkle(dynamics::CapsuleF
     w.compressed_area_fraction = diagnostics::compressed_area_fraction(
         flow.mesh(), x, flow.mechanics().principal_tensions(x), membrane_degree);
     w.load_roughness = diagnostics::load_roughness(flow.mesh(), x, q);
-    w.wrinkle_wavelength = diagnostics::WrinkleWavelength(flow.mesh())(x);
+    const auto relief = diagnostics::WrinkleWavelength(flow.mesh()).measure(x);
+    w.wrinkle_wavelength = relief.wavelength;
+    w.wrinkle_amplitude = relief.amplitude;
     return w;
   } catch (const membrane::DegenerateSurface&) {
     return std::nullopt;

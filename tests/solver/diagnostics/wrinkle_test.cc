@@ -143,8 +143,16 @@ TEST(WrinkleWavelength, FollowsTheShortWavesOfAWrinkledDeformation) {
   const double wrinkles = 2.0 * std::numbers::pi / std::sqrt(12 * 13.0);
   const double mixed = lambda(wavelength::perturbed(m.nodes, {{2, 0.05}, {12, 0.0025}}));
   EXPECT_NEAR(mixed / wrinkles, 1.0, 0.05) << mixed;
-  const double smooth = lambda(wavelength::perturbed(m.nodes, {{2, 0.05}}));
+  const auto smooth_relief = lambda.measure(wavelength::perturbed(m.nodes, {{2, 0.05}}));
+  const double smooth = smooth_relief.wavelength;
   EXPECT_GT(smooth, 2.0);
+  // The amplitudes: the wrinkles' A (t k²/(1 + t k²))^6 RMS(P_12), RMS(P_l) = 1/√(2l + 1); the smooth shape
+  // leaves a relief an order smaller (≈ 0.05 · 2e-4 / √5 from its l = 2 part, as much again from its O(ε²)
+  // harmonics up to l = 4, which pass more).
+  const double t = 0.04, pass = std::pow(t * 156 / (1 + t * 156), 6);
+  EXPECT_NEAR(lambda.measure(wavelength::perturbed(m.nodes, {{12, 0.0025}})).amplitude / (0.0025 * pass / 5.0), 1.0,
+              0.03);
+  EXPECT_LT(smooth_relief.amplitude, 0.1 * 0.0025 * pass / 5.0);
   std::printf("wrinkled %.4f (harmonic %.4f), smooth %.4f\n", mixed, wrinkles, smooth);
 }
 

@@ -109,10 +109,10 @@ int run_command(const std::vector<std::string>& args) {
                  r.stokes_s);
     std::fprintf(stderr,
                  "# wrinkle indicators (final / largest sampled): compressed area %.3f / %.3f, q.n roughness %.3f / "
-                 "%.3f; wrinkle wavelength (final) %.3g at relief %.2g\n",
+                 "%.3f; wrinkle wavelength (final / most wrinkled sample) %.3g / %.3g at relief %.2g / %.2g\n",
                  r.wrinkle_final.compressed_area_fraction, r.wrinkle_max.compressed_area_fraction,
                  r.wrinkle_final.load_roughness, r.wrinkle_max.load_roughness, r.wrinkle_final.wrinkle_wavelength,
-                 r.wrinkle_final.wrinkle_amplitude);
+                 r.wrinkle_max.wrinkle_wavelength, r.wrinkle_final.wrinkle_amplitude, r.wrinkle_max.wrinkle_amplitude);
   }
   if (json) {
     const nlohmann::json j = driver::CaseSummary::of(config, r).to_json();

@@ -117,6 +117,11 @@ class CaseRun {
       p_node_ = static_cast<int>(cp.scalars["p_node"]);
       wrinkle_max_.compressed_area_fraction = cp.scalars["max_compressed_area_fraction"];
       wrinkle_max_.load_roughness = cp.scalars["max_load_roughness"];
+      // The most wrinkled sample so far (absent in checkpoints from before the wavelength: none yet).
+      if (const auto a = cp.scalars.find("max_wrinkle_amplitude"); a != cp.scalars.end()) {
+        wrinkle_max_.wrinkle_amplitude = a->second;
+        wrinkle_max_.wrinkle_wavelength = cp.scalars["wrinkle_wavelength_of_max"];
+      }
       // The cost of the invocations before (absent in checkpoints from before they were kept: 0), so that a
       // resumed case reports what the uninterrupted one would (the campaigns' core-hours rest on it).
       evaluations_before_ = static_cast<long>(cp.scalars["flow_evaluations"]);
@@ -302,6 +307,8 @@ class CaseRun {
     cp.scalars["p_node"] = p_node_;
     cp.scalars["max_compressed_area_fraction"] = wrinkle_max_.compressed_area_fraction;
     cp.scalars["max_load_roughness"] = wrinkle_max_.load_roughness;
+    cp.scalars["max_wrinkle_amplitude"] = wrinkle_max_.wrinkle_amplitude;
+    cp.scalars["wrinkle_wavelength_of_max"] = wrinkle_max_.wrinkle_wavelength;
     cp.scalars["flow_evaluations"] = static_cast<double>(evaluations_before_ + flow_->timings().evaluations);
     cp.scalars["wall_s"] = wall_before_ + std::chrono::duration<double>(Clock::now() - wall0_).count();
     cp.strings["case"] = identity_;
@@ -312,6 +319,13 @@ class CaseRun {
     if (const auto w = measure_wrinkle(*flow_, x_, config_.membrane_degree)) {
       wrinkle_max_.compressed_area_fraction = std::max(wrinkle_max_.compressed_area_fraction, w->compressed_area_fraction);
       wrinkle_max_.load_roughness = std::max(wrinkle_max_.load_roughness, w->load_roughness);
+      // The wavelength of the most wrinkled sample (largest relief), not the largest wavelength: a tumbling
+      // capsule wrinkles in one phase of its period and is smooth in another, so the final state may show none.
+      if (std::isfinite(w->wrinkle_amplitude) &&
+          !(w->wrinkle_amplitude <= wrinkle_max_.wrinkle_amplitude)) {  // NaN so far: take it
+        wrinkle_max_.wrinkle_amplitude = w->wrinkle_amplitude;
+        wrinkle_max_.wrinkle_wavelength = w->wrinkle_wavelength;
+      }
       return *w;
     }
     return {};

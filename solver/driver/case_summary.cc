@@ -56,6 +56,8 @@ const NumberField kNumberFields[] = {
     CAPSIM_SUMMARY_NUMBER(max_load_roughness, wrinkle_max.load_roughness),
     CAPSIM_SUMMARY_NUMBER(wrinkle_wavelength, wrinkle_final.wrinkle_wavelength),
     CAPSIM_SUMMARY_NUMBER(wrinkle_amplitude, wrinkle_final.wrinkle_amplitude),
+    CAPSIM_SUMMARY_NUMBER(max_wrinkle_amplitude, wrinkle_max.wrinkle_amplitude),
+    CAPSIM_SUMMARY_NUMBER(wrinkle_wavelength_of_max, wrinkle_max.wrinkle_wavelength),
     CAPSIM_SUMMARY_NUMBER(dt, dt),
     CAPSIM_SUMMARY_NUMBER(t_final, t_final),
     CAPSIM_SUMMARY_NUMBER(wall_s, wall_s),

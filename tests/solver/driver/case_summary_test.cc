@@ -25,7 +25,7 @@ CaseSummary example() {
   s.converged = false;
   s.volume_drift = -1e-4;
   s.wrinkle_final = {0.1, 0.2, 0.5, 1e-3};
-  s.wrinkle_max = {0.3, 0.4};
+  s.wrinkle_max = {0.3, 0.4, 0.7, 2e-3};
   s.steps = 1234;
   s.flow_evaluations = 5678;
   s.dt = 0.02;
@@ -51,6 +51,8 @@ TEST(CaseSummary, JsonRoundTripKeepsEveryField) {
   EXPECT_EQ(t.wrinkle_max.load_roughness, 0.4);
   EXPECT_EQ(t.wrinkle_final.wrinkle_wavelength, 0.5);
   EXPECT_EQ(t.wrinkle_final.wrinkle_amplitude, 1e-3);
+  EXPECT_EQ(t.wrinkle_max.wrinkle_wavelength, 0.7);
+  EXPECT_EQ(t.wrinkle_max.wrinkle_amplitude, 2e-3);
 }
 
 // The keys campaign/README.md, "The worker contract" and the scripts rely on.
@@ -59,7 +61,8 @@ TEST(CaseSummary, JsonHasTheContractKeys) {
   for (const char* key : {"status", "reason", "Ca", "capillary_number", "aspect_ratio", "law", "skalak_C",
                           "mesh_level", "min_D12", "max_tau_min", "mean_D12", "period", "regime", "converged",
                           "volume_drift", "compressed_area_fraction", "load_roughness", "max_compressed_area_fraction",
-                          "max_load_roughness", "wrinkle_wavelength", "wrinkle_amplitude", "steps", "flow_evaluations", "dt", "t_final",
+                          "max_load_roughness", "wrinkle_wavelength", "wrinkle_amplitude", "max_wrinkle_amplitude",
+                          "wrinkle_wavelength_of_max", "steps", "flow_evaluations", "dt", "t_final",
                           "wall_s", "threads",
                           "case_file", "code_version", "solver_version"})
     EXPECT_TRUE(j.contains(key)) << key;

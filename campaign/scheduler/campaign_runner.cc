@@ -169,8 +169,10 @@ class Runner {
 
   void start(CaseRow row) {
     row.out_dir = prepare_case_folder(row, runs_dir_);
+    store_.set_case_folder(row.case_id, row.out_dir);
     const std::string toml = row.out_dir + "/case.toml";
-    const bool resume = row.resumable;
+    // Resumable, and its checkpoint is where it runs now (not when a copied database starts afresh).
+    const bool resume = row.resumable && has_checkpoint(row.out_dir);
     WorkerCommand cmd;
     cmd.executable = worker_;
     cmd.args = worker_args(toml, row.out_dir, threads_, resume);
@@ -359,7 +361,16 @@ ManagerLock::~ManagerLock() {
 void write_file_atomic(const std::string& path, const std::string& text) { io::write_text_atomically(path, text); }
 
 std::string prepare_case_folder(const CaseRow& row, const std::string& runs_dir) {
-  const std::string dir = row.out_dir.empty() ? runs_dir + "/" + row.case_id : row.out_dir;
+  // The folder lives under the runs folder of this invocation; the stored one is reused only where it lies
+  // there (the same --runs-dir as before). A copy of a database, or one moved to another machine, keeps the
+  // absolute folders of the original: writing there would overwrite another campaign's files (and a live
+  // worker's logs), so such a case gets a fresh folder here (a checkpoint left there is not used).
+  std::string dir = runs_dir + "/" + row.case_id;
+  if (!row.out_dir.empty()) {
+    const fs::path base = fs::weakly_canonical(fs::absolute(runs_dir));
+    const fs::path stored = fs::weakly_canonical(fs::absolute(row.out_dir));
+    if (std::mismatch(base.begin(), base.end(), stored.begin(), stored.end()).first == base.end()) dir = row.out_dir;
+  }
   fs::create_directories(dir);
   write_file_atomic(dir + "/case.toml", row.params.to_toml());
   return dir;

@@ -78,8 +78,9 @@ struct PreparedCampaign {
 /// @throws BadInput (nothing changed).
 PreparedCampaign prepare_campaign(const RunOptions& opt, const std::function<void(const std::string&)>& log);
 
-/// @brief Creates the folder of a case (row.out_dir, or runs_dir/case_id) and writes its case.toml
-/// atomically; returns the folder.
+/// @brief Creates the folder of a case (row.out_dir where it lies under runs_dir, else runs_dir/case_id: a
+/// copied or moved database never writes into the original's folders) and writes its case.toml atomically;
+/// returns the folder.
 std::string prepare_case_folder(const CaseRow& row, const std::string& runs_dir);
 
 /// @brief Recomputes the transitions of a campaign (analysis/ per group) and stores them; returns them.

@@ -349,6 +349,7 @@ int submit_campaign(const SubmitOptions& opt) {
   }
   for (auto& r : pending) {
     r.out_dir = prepare_case_folder(r, pc.runs_dir);
+    store.set_case_folder(r.case_id, r.out_dir);
     // A leftover result file that is not a valid result (it was not ingested) would make the task skip the
     // case: keep it aside for inspection.
     const std::string rf = r.out_dir + "/" + kResultFile;

@@ -355,6 +355,12 @@ std::vector<CaseRow> Store::running_cases() {
   return out;
 }
 
+void Store::set_case_folder(const std::string& case_id, const std::string& out_dir) {
+  Stmt u(*db_, "UPDATE cases SET out_dir=? WHERE case_id=? AND out_dir IS NOT ?");
+  u.bind(1, out_dir).bind(2, case_id).bind(3, out_dir);
+  u.step();
+}
+
 std::int64_t Store::mark_running(const std::string& case_id, const std::string& host, std::int64_t pid,
                                  bool resumed) {
   Transaction t(*db_);

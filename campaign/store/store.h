@@ -118,6 +118,8 @@ class Store {
   /// @brief Every case with status running (orphans after a manager crash).
   std::vector<CaseRow> running_cases();
 
+  /// @brief Records the folder a case runs in (prepare_case_folder's choice; recovery and collection read it).
+  void set_case_folder(const std::string& case_id, const std::string& out_dir);
   /// @brief Marks a case running and opens an attempt row; returns the attempt id.
   std::int64_t mark_running(const std::string& case_id, const std::string& host, std::int64_t pid, bool resumed);
   /// @brief Records a worker's end: result (done/unstable), interrupted (queued, resumable) or failed.

@@ -88,6 +88,41 @@ TEST(Faults, StopSignalCheckpointsWorkersAndRerunResumes) {
   }
 }
 
+// Every file under a folder with its contents (a snapshot to compare).
+std::map<std::string, std::string> folder_snapshot(const std::string& dir) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.is_regular_file()) out[e.path().string()] = read_file(e.path().string());
+  return out;
+}
+
+// Found while a copy of a running campaign's database was analysed: the copy kept the original's absolute
+// case folders and its manager rewrote their case.toml and truncated a live worker's logs. A campaign run on
+// a copy must write only under its own runs folder.
+TEST(Faults, ACopyOfTheDatabaseNeverWritesIntoTheOriginalsCaseFolders) {
+  const std::string dir = fresh_dir("faults_copy");
+  const std::string db = dir + "/study.db";
+  write_file(dir + "/c.toml", kTwelve);
+  pid_t pid = spawn_sh(campaign_cmd("FAKE_STEPS=20 FAKE_STEP_S=0.05", dir + "/c.toml", db, "--jobs 2"));
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  kill(pid, SIGINT);
+  ASSERT_EQ(wait_child(pid, 30), 3);  // interrupted: two resumable cases, the rest queued or done
+  const auto before = folder_snapshot(db + ".runs");
+  ASSERT_FALSE(before.empty());
+  fs::create_directories(dir + "/copy");
+  fs::copy_file(db, dir + "/copy/study.db");
+  auto r = sh(campaign_cmd("FAKE_STEPS=2 FAKE_STEP_S=0.001", dir + "/c.toml", dir + "/copy/study.db", "--jobs 2"));
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(sql_csv(dir + "/copy/study.db", "SELECT count(*) FROM cases WHERE status='done'"), "12\n");
+  EXPECT_EQ(folder_snapshot(db + ".runs"), before) << "the copy wrote into the original's case folders";
+  // The cases that had not finished in the original ran in the copy's own folder.
+  const std::string unfinished = sql_csv(db, "SELECT count(*) FROM cases WHERE status != 'done'");
+  EXPECT_NE(unfinished, "0\n");
+  EXPECT_EQ(sql_csv(dir + "/copy/study.db",
+                    "SELECT count(*) FROM cases WHERE out_dir LIKE '" + dir + "/copy/study.db.runs/%'"),
+            unfinished);
+}
+
 TEST(Faults, KillNineOfTheManagerThenResumeRunsEveryCaseExactlyOnce) {
   const std::string dir = fresh_dir("faults_kill9");
   const std::string db = dir + "/study.db";

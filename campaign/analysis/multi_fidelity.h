@@ -16,11 +16,12 @@
 ///    stopping once it is narrower than max(ca_tolerance, the answer's numerical error): refining a bracket
 ///    below what the mesh resolves buys nothing; without a Ca* band the minimum of min D12 is bracketed only
 ///    while it is within 3× the threshold (a band may lie between samples; a sphere's 0.45 has none);
-/// 5. **check** (a third level): the final bracketing cases of every answer re-run on the check level,
-///    which gives the mesh part of the error (analysis/uncertainty.h);
-/// 6. **dt check** (dt_check = true): the CaH-low case of each cell (else its Ca*-low case) on the answer
-///    level with time.dt = half the step it ran with.
-/// Phases 2–4 repeat as rounds until none adds a case; 5 and 6 run once, after them.
+/// 5. **dt check** (dt_check = true): the CaH-low case of each cell (else its Ca*-low case) on the answer
+///    level with time.dt = half the step it ran with;
+/// 6. **check** (a third level): the final bracketing cases of every answer re-run on the check level,
+///    which gives the mesh part of the error (analysis/uncertainty.h).
+/// Phases 2–4 repeat as rounds until none adds a case; 5 and 6 run once, after them (the cheap dt check
+/// first, so that a campaign interrupted among the check level's long cases has it).
 
 #include <vector>
 
@@ -49,11 +50,11 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
 /// saved"). 0 for a missing bracket.
 int bisections_saved(const Transition& t, double ca_tolerance);
 
-/// @brief Phase 5: the final brackets of the answer level on the check level (levels[2]; none without one).
+/// @brief Phase 6: the final brackets of the answer level on the check level (levels[2]; none without one).
 std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,
                                           int budget);
 
-/// @brief Phase 6: per cell, the CaH-low case of the answer level (else its Ca*-low case) with time.dt set
+/// @brief Phase 5: per cell, the CaH-low case of the answer level (else its Ca*-low case) with time.dt set
 /// to half the step it ran with; none where such a case exists already.
 std::vector<CaseParams> dt_check_cases(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,
                                        int budget);

@@ -283,13 +283,15 @@ int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& 
     add = answer_level_round(groups, mf, budget);
     phase = "multi-fidelity: level " + std::to_string(lv[1]) + " (seed, re-bracket" +
             (spec.analysis.adaptive ? ", refine)" : ")");
-    if (add.empty() && lv.size() > 2) {
-      add = check_level_cases(groups, mf, budget);
-      phase = "multi-fidelity: mesh check on level " + std::to_string(lv[2]);
-    }
+    // The dt check (answer level, one case per cell) before the check level: the check level's cases cost
+    // hours and a campaign may be interrupted among them; its errors should have their dt part by then.
     if (add.empty() && spec.analysis.dt_check) {
       add = dt_check_cases(groups, mf, budget);
       phase = "multi-fidelity: dt/2 check on level " + std::to_string(lv[1]);
+    }
+    if (add.empty() && lv.size() > 2) {
+      add = check_level_cases(groups, mf, budget);
+      phase = "multi-fidelity: mesh check on level " + std::to_string(lv[2]);
     }
   } else {
     add = refinement_round(groups, spec.analysis.d12_threshold, spec.analysis.ca_tolerance, budget);

@@ -35,5 +35,15 @@ TEST(CommittedResults, QuickTableIsWhatTheDatabaseGives) {
   expect_query_reproduces("table1_quick.sqlite", "table1_quick.json");
 }
 
+TEST(CommittedResults, MultiFidelityTableIsWhatTheDatabaseGives) {
+  expect_query_reproduces("table1_mf.sqlite", "table1_mf.json");
+}
+
+// The certified campaign shares its database with the multi-fidelity one it continues; the query's default
+// campaign is the most recently run, the certified one.
+TEST(CommittedResults, CertifiedTableIsWhatTheDatabaseGives) {
+  expect_query_reproduces("table1_certified.sqlite", "table1_certified.json");
+}
+
 }  // namespace
 }  // namespace capsim::campaign::testing

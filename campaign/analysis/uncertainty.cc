@@ -115,6 +115,8 @@ Part mesh_part(const Cell& cell, int level, Answer which, double a, double b, do
   Part p;
   if (coarse) levels_used.insert(level - 1);
   if (fine) levels_used.insert(level + 1);
+  // "level L: x" (4 significant digits) is also read back: `scripts/table1 --error-check` takes the check
+  // level's value from this text in the stored error_note. Keep the form, or change both.
   auto text = [](int l, double x) { return "level " + std::to_string(l) + ": " + format_significant(x, 4); };
   if (coarse && fine) {
     const double d1 = here - *coarse, d2 = *fine - here;

@@ -8,6 +8,7 @@
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/Sparse>
 
+#include "solver/membrane/load_solver.h"
 #include "solver/mesh/p2_tabulation.h"
 
 namespace capsim::diagnostics {
@@ -67,13 +68,12 @@ WrinkleWavelength::WrinkleWavelength(const mesh::SurfaceMesh& mesh) : WrinkleWav
 WrinkleWavelength::Relief WrinkleWavelength::measure(const Eigen::Matrix3Xd& x) const {
   const int ne = mesh_.num_elements(), nq = p2_.size(), nn = mesh_.num_nodes();
   if (x.cols() != nn) throw std::invalid_argument("WrinkleWavelength: x needs one column per node");
-  // Assemble: M_ab = ∫ φ_a φ_b dS, Ks_ab = ∫ ∇s φ_a · ∇s φ_b dS = Σ w J ∂_α φ_a g^{αβ} ∂_β φ_b.
-  std::vector<Eigen::Triplet<double>> tm, tk;
-  tm.reserve(static_cast<std::size_t>(ne) * 36);
+  // Ks_ab = ∫ ∇s φ_a · ∇s φ_b dS = Σ w J ∂_α φ_a g^{αβ} ∂_β φ_b; M is the load solver's P2 mass matrix on x.
+  std::vector<Eigen::Triplet<double>> tk;
   tk.reserve(static_cast<std::size_t>(ne) * 36);
   for (int e = 0; e < ne; ++e) {
     const auto& el = mesh_.elements[e];
-    double me[6][6] = {}, ke[6][6] = {};
+    double ke[6][6] = {};
     for (int q = 0; q < nq; ++q) {
       const auto t = p2_.tangents(x, el, q);
       const double g11 = t.g1.dot(t.g1), g12 = t.g1.dot(t.g2), g22 = t.g2.dot(t.g2);
@@ -83,21 +83,17 @@ WrinkleWavelength::Relief WrinkleWavelength::measure(const Eigen::Matrix3Xd& x) 
       const mesh::P2Point& p = p2_[q];
       for (int a = 0; a < 6; ++a) {
         const double u1 = (g22 * p.dxi[a] - g12 * p.deta[a]) / det, u2 = (g11 * p.deta[a] - g12 * p.dxi[a]) / det;
-        for (int b = 0; b < 6; ++b) {
-          me[a][b] += w * p.n[a] * p.n[b];
-          ke[a][b] += w * (u1 * p.dxi[b] + u2 * p.deta[b]);
-        }
+        for (int b = 0; b < 6; ++b) ke[a][b] += w * (u1 * p.dxi[b] + u2 * p.deta[b]);
       }
     }
     for (int a = 0; a < 6; ++a)
-      for (int b = 0; b < 6; ++b) {
-        tm.emplace_back(el[a], el[b], me[a][b]);
-        tk.emplace_back(el[a], el[b], ke[a][b]);
-      }
+      for (int b = 0; b < 6; ++b) tk.emplace_back(el[a], el[b], ke[a][b]);
   }
-  Eigen::SparseMatrix<double> M(nn, nn), K(nn, nn);
-  M.setFromTriplets(tm.begin(), tm.end());
+  Eigen::SparseMatrix<double> K(nn, nn);
   K.setFromTriplets(tk.begin(), tk.end());
+  membrane::LoadSolver mass(mesh_, membrane::LoadSolver::Options{});  // degree 6, as Ks
+  mass.assemble(x);
+  const Eigen::SparseMatrix<double>& M = mass.mass_matrix();
   // High-pass: y ← (M + t Ks)⁻¹ t Ks y, m times (each coordinate).
   const double t = options_.filter_length * options_.filter_length;
   const Eigen::SparseMatrix<double> A = M + t * K;
@@ -114,14 +110,13 @@ WrinkleWavelength::Relief WrinkleWavelength::measure(const Eigen::Matrix3Xd& x) 
   const Eigen::Matrix3Xd normals = mesh::node_normals(mesh_, x);
   Eigen::VectorXd u(nn);
   for (int i = 0; i < nn; ++i) u[i] = normals.col(i).dot(y.row(i).transpose());
-  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(nn);
-  const Eigen::VectorXd m_ones = M * ones;
-  u.array() -= u.dot(m_ones) / ones.dot(m_ones);
+  const Eigen::VectorXd m_ones = M * Eigen::VectorXd::Ones(nn);  // ∫ φ_a dS
+  const double area = m_ones.sum();
+  u.array() -= u.dot(m_ones) / area;
   const double a0 = u.dot(M * u), b0 = u.dot(K * u);
-  // Relief below round-off of the positions (relative 1e-13 of the size): none to measure.
-  const double size2 = ones.dot(m_ones) * (x.rowwise().maxCoeff() - x.rowwise().minCoeff()).squaredNorm();
-  if (!(a0 > 1e-26 * size2) || !(b0 > 0)) return {};
-  const double area = ones.dot(m_ones);
+  // Relief below round-off of the positions (RMS under 1e-13 of the size): none to measure.
+  const double size2 = (x.rowwise().maxCoeff() - x.rowwise().minCoeff()).squaredNorm();
+  if (!(a0 > 1e-26 * area * size2) || !(b0 > 0)) return {};
   return {2.0 * std::numbers::pi * std::sqrt(a0 / b0), std::sqrt(a0 / area)};
 }
 

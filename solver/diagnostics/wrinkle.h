@@ -63,9 +63,10 @@ double load_roughness(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x, 
 
 /// @brief The wrinkle wavelength of a surface (see the file comment), on one mesh.
 ///
-/// Contract: every evaluation assembles M and Ks on x (quadrature degree 6) and solves (M + t Ks) y = t Ks y'
-/// m times for the three coordinates by Jacobi-preconditioned CG (relative residual 1e-10); about as much
-/// work as a few load solves. Deterministic; thread-safe (no cached state).
+/// Contract: every evaluation assembles Ks on x and takes M from membrane::LoadSolver (quadrature degree 6),
+/// and solves (M + t Ks) y = t Ks y' m times for the three coordinates by Jacobi-preconditioned CG
+/// (relative residual 1e-10); about as much work as a few load solves. Deterministic; thread-safe (no cached
+/// state).
 class WrinkleWavelength {
  public:
   struct Options {

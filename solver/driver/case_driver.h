@@ -52,7 +52,9 @@ struct CaseResult {
   diagnostics::PeriodAnalysis analysis;
   double volume_drift = 0;           ///< (V(t_final) − V0)/V0
   /// Wrinkle indicators (diagnostics/wrinkle.h) of the final state, and their largest values sampled
-  /// every time unit over the run (carried through checkpoints).
+  /// every time unit over the run (carried through checkpoints). In wrinkle_max the area fraction, the
+  /// roughness and the amplitude are maxima; its wrinkle_wavelength is not a maximum but the λ of the
+  /// most wrinkled sample (the one with the largest amplitude).
   diagnostics::WrinkleIndicators wrinkle_final, wrinkle_max;
   long steps = 0;
   long flow_evaluations = 0;        ///< velocity evaluations of the time steps (snapshots reuse a step's own)

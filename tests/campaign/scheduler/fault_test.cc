@@ -88,14 +88,6 @@ TEST(Faults, StopSignalCheckpointsWorkersAndRerunResumes) {
   }
 }
 
-// Every file under a folder with its contents (a snapshot to compare).
-std::map<std::string, std::string> folder_snapshot(const std::string& dir) {
-  std::map<std::string, std::string> out;
-  for (const auto& e : fs::recursive_directory_iterator(dir))
-    if (e.is_regular_file()) out[e.path().string()] = read_file(e.path().string());
-  return out;
-}
-
 // Found while a copy of a running campaign's database was analysed: the copy kept the original's absolute
 // case folders and its manager rewrote their case.toml and truncated a live worker's logs. A campaign run on
 // a copy must write only under its own runs folder.

@@ -168,8 +168,8 @@ TEST(WrinkleWavelength, OfMeshScaleNoiseHalvesWithTheNodeSpacing) {
     lambdas.push_back(WrinkleWavelength(m)(x));
   }
   std::printf("noise: %.4f %.4f %.4f\n", lambdas[0], lambdas[1], lambdas[2]);
-  // Measured: 0.257, 0.146, 0.078 (ratios 1.76 and 1.87, approaching 2 with refinement; the filter still
-  // damps level 2's longest noise waves by up to ≈ 20 %, t k² ≈ 20 there). A λ that did not follow the mesh fails.
+  // Measured: 0.257, 0.146, 0.078 (ratios 1.76 and 1.87, approaching 2 with refinement; at level 2's λ the
+  // filter weight (t k²/(1 + t k²))^6 is 0.78, at level 3's 0.92). A λ that did not follow the mesh fails.
   EXPECT_NEAR(lambdas[0] / lambdas[1], 2.0, 0.3);
   EXPECT_NEAR(lambdas[1] / lambdas[2], 2.0, 0.3);
   EXPECT_LT(lambdas[2], 0.2);

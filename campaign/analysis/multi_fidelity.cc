@@ -102,7 +102,13 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
         // and below a lower critical number CaL (Lac et al. 2004; the NH sphere on level 3: τ < 0 at 0.4,
         // > 0 at 0.5, < 0 again above 0.62). So probe both ways: below the smallest sample, and the next
         // scan Ca above the largest one (within the scan's range: the grid's author chose it).
-        p.add(below(*ta.ca_h_high, true));
+        // Below the scan's range by one step (÷1.5) at most: as Ca -> 0 the tensions vanish with Ca, so max
+        // τmin may tend to 0 from below with no window of τ > 0 at all (the NH sphere with κ_b = 1e-2:
+        // −0.022 at Ca 0.01, −0.14 at 0.12, −0.02 at 0.6; walking down by ÷1.5 spent 12 cases finding
+        // nothing). Past that step the answer is "max τmin < 0 at every sampled Ca".
+        const double smallest = *ta.ca_h_high;
+        if (!scan_ca.empty() && (smallest > scan_ca.front() || same_ca(smallest, scan_ca.front())))
+          p.add(below(smallest, true));  // the next scan Ca below, or one step below the scan's range
         double largest = *ta.ca_h_high;
         for (const auto& s : answer->samples)
           if (s.max_tau_min) largest = std::max(largest, s.ca);

@@ -40,7 +40,7 @@ std::vector<double> propose_refinement(const Transition& t, std::vector<Sample> 
   if (t.ca_star_high && t.ca_star_above && *t.ca_star_above - *t.ca_star_high > std::max(tol, per.ca_star_high))
     add(0.5 * (*t.ca_star_high + *t.ca_star_above));
   // No sample below the threshold yet: bracket the minimum of min D12 more finely around the best sample.
-  if (!t.ca_star_low && t.ca_min_d12 && per.bracket_minimum) {
+  if (!t.ca_star_low && t.ca_min_d12 && per.bracket_minimum && !is_sphere(t)) {
     auto it = std::find_if(samples.begin(), samples.end(), [&](const Sample& s) { return s.ca == *t.ca_min_d12; });
     if (it != samples.end()) {
       if (it != samples.begin() && it->ca - std::prev(it)->ca > tol) add(0.5 * (it->ca + std::prev(it)->ca));

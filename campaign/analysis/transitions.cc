@@ -21,11 +21,17 @@ Transition analyse_group(Transition t, std::vector<Sample> samples, double thr) 
   t.ca_h_high_case.clear();
   std::vector<std::string> notes;
 
-  // Ca*: the sampled Ca with min D12 < threshold.
+  // Ca*: the sampled Ca with min D12 < threshold (not for a sphere: is_sphere says why).
   std::vector<const Sample*> d12;
   for (const auto& s : samples)
     if (s.min_d12) d12.push_back(&s);
-  if (!d12.empty()) {
+  if (!d12.empty() && is_sphere(t)) {
+    const Sample* best = *std::min_element(d12.begin(), d12.end(),
+                                           [](const Sample* a, const Sample* b) { return *a->min_d12 < *b->min_d12; });
+    t.ca_min_d12 = best->ca;
+    notes.push_back("a/b = 1: a sphere does not tumble, Ca* does not apply (smallest min_D12 " +
+                    format_significant(*best->min_d12) + " at Ca=" + format_sampled(best->ca) + ")");
+  } else if (!d12.empty()) {
     const Sample* best = *std::min_element(d12.begin(), d12.end(),
                                            [](const Sample* a, const Sample* b) { return *a->min_d12 < *b->min_d12; });
     t.ca_min_d12 = best->ca;
@@ -85,6 +91,8 @@ Transition analyse_group(Transition t, std::vector<Sample> samples, double thr) 
   for (const auto& n : notes) t.note += (t.note.empty() ? "" : "; ") + n;
   return t;
 }
+
+bool is_sphere(const Transition& t) { return std::abs(t.aspect_ratio - 1.0) < 1e-9; }
 
 std::string group_key(const CaseParams& params) {
   // The case identity hashes canonical() ("key=value" lines of the solver's resolved configuration, output keys

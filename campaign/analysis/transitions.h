@@ -46,6 +46,12 @@ struct Transition {
   std::string error_note;    ///< provenance: every part of every error and how it was obtained
 };
 
+/// @brief True for an initially spherical capsule (a/b = 1). It does not tumble, so the seed's Ca* (the
+/// band of a tumbling-to-swinging transition) does not apply to it: its min D12 falls below any threshold as
+/// Ca -> 0 simply because a sphere at rest has D12 = 0 (with bending stiffness the sphere's level-3 min D12
+/// is below 0.15 already at Ca = 0.03), which is no transition.
+bool is_sphere(const Transition& t);
+
 /// @brief One finished case of a group.
 struct Sample {
   double ca = 0;                        ///< capillary number

@@ -50,7 +50,8 @@ double bending_modulus_of(const std::string& group_key) {
   return 0.0;
 }
 
-int table1(campaign::Store& store, const std::string& name, campaign::Format fmt, int mesh_level, double skalak_C) {
+int table1(campaign::Store& store, const std::string& name, campaign::Format fmt, int mesh_level, double skalak_C,
+           std::optional<double> bending_modulus) {
   const std::string camp = resolve_campaign(store, name);
   std::vector<campaign::Transition> rows;
   // Per (law, a/b): the finest mesh level. Two groups there (two Skalak C, or a numerics axis) do not fit in
@@ -60,6 +61,10 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
     // Scan, mesh-check and dt-check groups serve the answer's error; with --mesh-level the user asks for
     // that level whatever its role.
     if (r.role != "answer" && mesh_level < 0) continue;
+    // --bending-modulus picks one κ_b of a campaign with a bending axis (absent from a group key means 0).
+    if (bending_modulus && std::abs(bending_modulus_of(r.group_key) - *bending_modulus) >
+                               1e-12 * std::max(1.0, std::abs(*bending_modulus)))
+      continue;
     auto key = std::make_pair(r.law, r.aspect_ratio);
     if (auto it = seen.find(key); it != seen.end()) {
       const auto& first = rows[it->second];
@@ -67,6 +72,12 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
         if (first.skalak_C != r.skalak_C)
           throw BadInput("campaign '" + camp + "' has several skalak_C values for " + r.law + " a/b=" +
                          campaign::canonical_double(r.aspect_ratio) + "; choose one with --skalak-C");
+        if (bending_modulus_of(first.group_key) != bending_modulus_of(r.group_key))
+          throw BadInput("campaign '" + camp + "' has several bending moduli for " + r.law + " a/b=" +
+                         campaign::canonical_double(r.aspect_ratio) + " (" +
+                         campaign::canonical_double(bending_modulus_of(first.group_key)) + " and " +
+                         campaign::canonical_double(bending_modulus_of(r.group_key)) +
+                         "); choose one with --bending-modulus");
         throw BadInput("campaign '" + camp + "' has several transition groups for " + r.law + " a/b=" +
                        campaign::canonical_double(r.aspect_ratio) + " at mesh level " + std::to_string(r.mesh_level) +
                        ", they differ in " + campaign::group_difference(first.group_key, r.group_key) +
@@ -77,6 +88,9 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
     seen[key] = rows.size();
     rows.push_back(std::move(r));
   }
+  if (rows.empty() && bending_modulus)
+    throw BadInput("campaign '" + camp + "' has no transitions with capsule.bending_modulus = " +
+                   campaign::canonical_double(*bending_modulus));
   if (rows.empty())
     throw BadInput("campaign '" + camp + "' has no transitions yet (run it first: capsim campaign run ...)");
   if (fmt != campaign::Format::kMarkdown) {
@@ -128,7 +142,8 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
       };
       star += r->ca_star_low && r->ca_star_high ? " Ca* ∈ [" + edge(r->ca_star_low, r->ca_star_low_err) + ", " +
                                                       edge(r->ca_star_high, r->ca_star_high_err) + "] |"
-                                                : " Ca* not found |";
+              : campaign::is_sphere(*r)           ? " ⋆ (a sphere does not tumble) |"
+                                                  : " Ca* not found |";
       h += r->ca_h && r->ca_h_low && r->ca_h_high
                ? " CaH = " + (r->ca_h_err ? campaign::format_plus_minus(*r->ca_h, *r->ca_h_err)
                                           : campaign::format_with_error(*r->ca_h, *r->ca_h_high - *r->ca_h_low)) + " |"
@@ -187,6 +202,9 @@ int query_command(const std::vector<std::string>& args) {
   double skalak_C = -1;
   t1->add_option("--mesh-level", mesh_level, "only this mesh level (default: the finest per group)");
   t1->add_option("--skalak-C", skalak_C, "only this Skalak C");
+  double bending = -1;
+  t1->add_option("--bending-modulus", bending, "only this capsule.bending_modulus (a campaign with a bending axis)")
+      ->check(CLI::NonNegativeNumber);
   auto* cs = app.add_subcommand("cases", "cases with their results; CSV export for plotting");
   common(cs);
   std::string law, status;
@@ -213,7 +231,9 @@ int query_command(const std::vector<std::string>& args) {
   try {
     const auto fmt = campaign::parse_format(format);
     auto store = campaign::Store::open_readonly(db);
-    if (*t1) return table1(*store, camp, fmt, mesh_level, skalak_C);
+    if (*t1)
+      return table1(*store, camp, fmt, mesh_level, skalak_C,
+                    bending >= 0 ? std::optional<double>(bending) : std::nullopt);
     if (*cs) return cases(*store, camp, fmt, law, ar, ca_min, ca_max, status);
     return sql(*store, text, fmt);
   } catch (const BadInput& e) {

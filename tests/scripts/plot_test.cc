@@ -163,7 +163,7 @@ TEST_F(ScriptsTest, Table1FromTheDatabaseComparesCellByCell) {
   EXPECT_NE(t.find("✗ [0.30, 0.35] · seed [0.20, 0.25]"), std::string::npos) << t;
   EXPECT_NE(t.find("not sampled"), std::string::npos) << t;
   EXPECT_NE(t.find("min_D12 never below 0.05"), std::string::npos) << t;
-  EXPECT_NE(t.find("seed 2.50"), std::string::npos) << t;
+  EXPECT_NE(t.find("seed 2.5 "), std::string::npos) << t;  // with the digits the seed printed
 }
 
 TEST_F(ScriptsTest, Table1FromCapsimQueryJson) {
@@ -180,22 +180,33 @@ TEST_F(ScriptsTest, Table1FromCapsimQueryJson) {
   EXPECT_NE(piped.out.find("Agree: 3, disagree: 1, missing: 6."), std::string::npos);
 }
 
-// Answers with errors (capsim query table1 of a schema-4 database) print "x ± e" and say how far the seed is.
+// Answers with errors (capsim query table1 of a schema-4 database) print "x ± e" and say how far the seed is,
+// counted from the nearest value the seed's number allows (results/seed_table1.json): a CaH to its printed
+// digits, a Ca* edge to the seed's sampling step outwards. Each expected distance differs from the one
+// counted from the printed value, so the test fails if the rounding or the step is ignored.
 TEST_F(ScriptsTest, Table1PrintsErrorsAndHowFarTheSeedIs) {
   const auto js = dir_ / "table1_err.json";
   {
     std::ofstream f(js);
-    f << R"([{"law": "neo-hookean", "aspect_ratio": 0.5, "ca_star_low": 0.025, "ca_star_high": 0.05,
-              "ca_h": 0.6034, "ca_star_low_err": 0.004, "ca_star_high_err": 0.012, "ca_h_err": 0.047},
+    f << R"([{"law": "neo-hookean", "aspect_ratio": 0.5, "ca_star_low": 0.026, "ca_star_high": 0.056,
+              "ca_h": 0.6034, "ca_star_low_err": 0.003, "ca_star_high_err": 0.004, "ca_h_err": 0.047},
+             {"law": "skalak", "aspect_ratio": 1.0, "ca_h": 2.46, "ca_h_err": 0.004},
              {"law": "skalak", "aspect_ratio": 2.0, "ca_star_low": 0.216, "ca_star_high": 0.369,
               "ca_h": 1.31, "ca_h_err": 0.12}])";
   }
   const Cmd r = sh(table1() + " --json " + q(js));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("0.60 ± 0.05 · seed 0.70"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("[0.025 ± 0.004, 0.05 ± 0.02]"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("seed 2.1 errors away"), std::string::npos) << r.out;  // |0.6034 - 0.70| / 0.047
-  EXPECT_NE(r.out.find("1.3 ± 0.2 · seed 1.40"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("[0.026 ± 0.003, 0.056 ± 0.004]"), std::string::npos) << r.out;
+  // Lower edge: seed 0.02 sampled at step 0.01, crossing in [0.01, 0.02]: (0.026 - 0.02) / 0.003.
+  EXPECT_NE(r.out.find("lower edge: seed 2.0 errors away"), std::string::npos) << r.out;
+  // Upper edge: seed 0.04, crossing in [0.04, 0.05]: (0.056 - 0.05) / 0.004 (4.0 from the printed 0.04).
+  EXPECT_NE(r.out.find("upper edge: seed 1.5 errors away"), std::string::npos) << r.out;
+  // CaH 0.70 printed to 0.01, so in [0.695, 0.705]: (0.695 - 0.6034) / 0.047 (2.1 from the printed 0.70).
+  EXPECT_NE(r.out.find("seed 1.9 errors away"), std::string::npos) << r.out;
+  // CaH 2.4 printed to 0.1, so in [2.35, 2.45]: (2.46 - 2.45) / 0.004 (15 from the printed 2.4).
+  EXPECT_NE(r.out.find("seed 2.5 errors away"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1.3 ± 0.2 · seed 1.4 "), std::string::npos) << r.out;  // the seed's digits
   EXPECT_NE(r.out.find("seed within our error"), std::string::npos) << r.out;  // |1.31 - 1.40| < 0.12
 }
 

@@ -99,6 +99,20 @@ TEST(MultiFidelity, AllCompressedOnTheAnswerLevelProbesBothWays) {
   EXPECT_FALSE(add.empty());
 }
 
+TEST(MultiFidelity, AllCompressedProbesOneStepBelowTheScanAndStops) {
+  // The NH sphere with κ_b = 1e-2: max τmin < 0 at every Ca, tending to 0 from below as Ca -> 0. The round
+  // looks one step (÷1.5) below the scan's range and no further: walking down by ÷1.5 finds nothing.
+  const auto tau = [](double ca) { return -0.1 * ca; };
+  std::vector<CaseSample> cases;
+  for (double ca : {0.4, 0.6, 0.8}) cases.push_back(fake(2, ca, tau));
+  for (double ca : {0.4, 0.6, 0.8}) cases.push_back(fake(3, ca, tau));
+  auto add = answer_level_round(group_cases(cases), kOptions, 100);
+  EXPECT_EQ(ca_at(add, 3), (std::vector<double>{0.267}));
+  cases.push_back(fake(3, 0.267, tau));
+  add = answer_level_round(group_cases(cases), kOptions, 100);
+  EXPECT_TRUE(add.empty()) << "already one step below the scan's smallest Ca 0.4: " << add.size() << " proposed";
+}
+
 TEST(MultiFidelity, RefinementStopsAtTheNumericalError) {
   // The level-2 and level-3 values differ by 0.37 in τ (slope −1): the CaH error is 0.37, so a bracket of
   // width 0.1 is already narrower than what the mesh resolves; with a level 2 close to level 3 it is not.

@@ -47,5 +47,38 @@ capillary_number = [0.1, 0.2, 0.3, 0.4]
   EXPECT_NE(q.err.find("time.dt"), std::string::npos) << q.err;
 }
 
+// A bending axis (issue 15: Table 1 at several κ_b in one campaign): query table1 names the option that picks
+// one κ_b, and with it prints that κ_b's table, headed by its value.
+TEST(TransitionGroups, BendingAxisIsChosenWithBendingModulus) {
+  const std::string dir = fresh_dir("transition_groups_bending");
+  const std::string db = dir + "/study.db";
+  write_file(dir + "/g.toml", R"([campaign]
+name = "kb-axis"
+[defaults]
+mesh.level = 1
+[[grid]]
+aspect_ratio = [2.0]
+law = ["neo-hookean"]
+bending_modulus = [0.0, 1e-3]
+capillary_number = [0.1, 0.2, 0.3, 0.4]
+)");
+  auto r = sh(campaign_cmd("FAKE_STEPS=1 FAKE_STEP_S=0.001", dir + "/g.toml", db, "--jobs 2"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto q = sh(exe() + " query table1 --db " + db);
+  EXPECT_EQ(q.code, 2) << q.out;
+  EXPECT_NE(q.err.find("--bending-modulus"), std::string::npos) << q.err;
+  q = sh(exe() + " query table1 --db " + db + " --bending-modulus 0.001");
+  ASSERT_EQ(q.code, 0) << q.err;
+  EXPECT_NE(q.out.find("Bending modulus κ_b = 0.001"), std::string::npos) << q.out;
+  q = sh(exe() + " query table1 --db " + db + " --bending-modulus 0 --format json");
+  ASSERT_EQ(q.code, 0) << q.err;
+  const auto rows = nlohmann::json::parse(q.out);
+  ASSERT_EQ(rows.size(), 1u) << q.out;
+  EXPECT_DOUBLE_EQ(rows[0]["bending_modulus"].get<double>(), 0.0);
+  q = sh(exe() + " query table1 --db " + db + " --bending-modulus 0.5");
+  EXPECT_EQ(q.code, 2) << q.out;
+  EXPECT_NE(q.err.find("no transitions with capsule.bending_modulus = 0.5"), std::string::npos) << q.err;
+}
+
 }  // namespace
 }  // namespace capsim::campaign::testing

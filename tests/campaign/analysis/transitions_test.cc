@@ -93,6 +93,25 @@ TEST(Transitions, NoSampleBelowThreshold) {
   EXPECT_NE(t.note.find("never below"), std::string::npos);
 }
 
+TEST(Transitions, ASphereHasNoCaStarAndNoMinimumToBracket) {
+  // A sphere's min D12 -> 0 as Ca -> 0 (D12 = 0 at rest): below the threshold at small Ca, yet no transition.
+  auto s = samples({0.005, 0.02, 0.1}, [](double ca) { return 5.0 * ca; }, tau_oblate);
+  Transition key;
+  key.aspect_ratio = 1.0;
+  Transition t = analyse_group(key, s, 0.05);
+  EXPECT_FALSE(t.ca_star_low);
+  EXPECT_FALSE(t.ca_star_high);
+  EXPECT_DOUBLE_EQ(*t.ca_min_d12, 0.005);
+  EXPECT_NE(t.note.find("Ca* does not apply"), std::string::npos) << t.note;
+  // max τmin > 0 everywhere here, so nothing else to refine: no bisection around the smallest min D12.
+  EXPECT_TRUE(propose_refinement(t, s, 0.005).empty());
+  // The same samples on an oblate capsule are a Ca* band [0.005].
+  key.aspect_ratio = 0.5;
+  t = analyse_group(key, s, 0.05);
+  ASSERT_TRUE(t.ca_star_low);
+  EXPECT_DOUBLE_EQ(*t.ca_star_low, 0.005);
+}
+
 TEST(Adaptive, ProposalsShrinkBracketsAndConverge) {
   // Start coarse, add the proposals of each round: the Ca* edges and CaH converge to the tolerance.
   std::vector<double> cas = {0.01, 0.1, 0.4, 0.8, 1.2};

@@ -210,6 +210,26 @@ TEST_F(ScriptsTest, Table1PrintsErrorsAndHowFarTheSeedIs) {
   EXPECT_NE(r.out.find("seed within our error"), std::string::npos) << r.out;  // |1.31 - 1.40| < 0.12
 }
 
+// A campaign with a bending axis has two rows per cell: scripts/table1 names the option instead of picking one,
+// and with it compares that κ_b's answers, saying that the seed's membrane has no bending stiffness.
+TEST_F(ScriptsTest, Table1ChoosesOneBendingModulus) {
+  const auto js = dir_ / "table1_kb.json";
+  {
+    std::ofstream f(js);
+    f << R"([{"law": "skalak", "aspect_ratio": 1.0, "ca_h": 2.46, "ca_h_err": 0.04, "bending_modulus": 0.001},
+             {"law": "skalak", "aspect_ratio": 1.0, "ca_h": 2.59, "ca_h_err": 0.07, "bending_modulus": 0.01}])";
+  }
+  const Cmd both = sh(table1() + " --json " + q(js));
+  EXPECT_EQ(both.code, 2) << both.out;
+  EXPECT_NE(both.err.find("--bending-modulus"), std::string::npos) << both.err;
+  const Cmd one = sh(table1() + " --json " + q(js) + " --bending-modulus 0.01");
+  ASSERT_EQ(one.code, 0) << one.err;
+  EXPECT_NE(one.out.find("2.59 ± 0.07 · seed 2.4"), std::string::npos) << one.out;
+  EXPECT_NE(one.out.find("κ_b = 0.01; the seed's membrane has none"), std::string::npos) << one.out;
+  const Cmd none = sh(table1() + " --json " + q(js) + " --bending-modulus 0.1");
+  EXPECT_EQ(none.code, 2) << none.out;
+}
+
 TEST_F(ScriptsTest, MissingInputsExitTwoWithOneMessage) {
   const auto nope = dir_ / "does-not-exist";
   for (const std::string& cmd :

@@ -127,7 +127,8 @@ TEST_F(ScriptsTest, PlotsFigure3AndFigure2FromTheDatabase) {
   EXPECT_NE(r.err.find("Ca = 0.1"), std::string::npos) << "missing figure-2 case not reported: " << r.err;
 }
 
-// Figure 4 (bending) from a real tiny bending campaign: level 1, κ_b = 0, 1e-3, 1e-2, γ̇t ≤ 1 (seconds).
+// Figures 4 and 5 (bending) from a real tiny bending campaign: level 1, κ_b = 0, 1e-3, 1e-2, γ̇t ≤ 1 (seconds);
+// figure 5 from a committed study with full periods.
 TEST_F(ScriptsTest, PlotsTheBendingFigureFromABendingCampaign) {
   const auto toml = dir_ / "bending.toml";
   {
@@ -141,9 +142,18 @@ TEST_F(ScriptsTest, PlotsTheBendingFigureFromABendingCampaign) {
   ASSERT_EQ(run.code, 0) << run.err;
   const auto out = dir_ / "fig_bending";
   fs::remove_all(out);
-  const Cmd r = sh(plot() + " --db " + q(db) + " --only 4 --out " + q(out));
+  const Cmd r = sh(plot() + " --db " + q(db) + " --only 4,5 --out " + q(out));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(is_png(out / "bending_figure4.png"));
+  // γ̇t ≤ 1 holds no full period: figure 5 (the answers against κ_b) says why it is not drawn.
+  EXPECT_FALSE(fs::exists(out / "bending_figure5.png"));
+  EXPECT_NE(r.err.find("figure 5: none of the bending cases"), std::string::npos) << r.err;
+  const auto out5 = dir_ / "fig_bending5";
+  fs::remove_all(out5);
+  const Cmd f5 = sh(plot() + " --db " + q(fs::path(kSrc) / "results" / "bending" / "convergence.sqlite") +
+                    " --only 5 --out " + q(out5));
+  ASSERT_EQ(f5.code, 0) << f5.err;
+  EXPECT_TRUE(is_png(out5 / "bending_figure5.png"));
   // A database without bending has nothing for figure 4: one note, exit 1.
   const Cmd none = sh(plot() + " --db " + q(dir_ / "fixture.sqlite") + " --only 4 --out " + q(out));
   EXPECT_EQ(none.code, 1) << none.err;

@@ -126,12 +126,12 @@ class Runner {
         start(row);
       }
       queued_ = static_cast<int>(pending.size());
-      progress_.show(counts());
+      progress_.show(counts(pending));
       if (g_stop_signal && running_.empty()) break;
       std::this_thread::sleep_for(std::chrono::milliseconds(25));
     }
     queued_ = static_cast<int>(pending.size());
-    progress_.show(counts(), true);
+    progress_.show(counts(pending), true);
     return g_stop_signal == 0;
   }
 
@@ -141,30 +141,22 @@ class Runner {
   int interrupted() const { return static_cast<int>(interrupted_.size()); }
 
  private:
-  ProgressCounts counts() const {
+  ProgressCounts counts(const std::vector<CaseRow>& pending) const {
     ProgressCounts c;
     c.total = total_;
     c.finished = finished_;
     c.failed = failed_;
     c.running = static_cast<int>(running_.size());
     c.queued = queued_;
-    if (cost_done_ > 0 && wall_done_ > 0) {
-      double remaining = pending_cost_estimate();
-      c.eta_s = wall_done_ / cost_done_ * remaining / std::max(1, jobs_);
-    }
+    std::vector<std::pair<int, double>> todo;
+    todo.reserve(pending.size());
+    for (const auto& r : pending) todo.emplace_back(r.params.mesh_level(), r.est_cost);
+    std::vector<std::tuple<int, double, double>> busy;
+    const auto now = std::chrono::steady_clock::now();
+    for (const auto& [_, r] : running_)
+      busy.emplace_back(r.row.params.mesh_level(), r.row.est_cost, std::chrono::duration<double>(now - r.start).count());
+    c.eta_s = eta_.remaining_s(todo, busy, jobs_);
     return c;
-  }
-  double pending_cost_estimate() const {
-    // Queued cost is not tracked per case here; approximate with the mean finished cost per case.
-    double mean_cost = cost_done_ / std::max(1, n_done_session_);
-    double rem = queued_ * mean_cost;
-    auto now = std::chrono::steady_clock::now();
-    for (const auto& [_, r] : running_) {
-      double expect = r.row.est_cost * wall_done_ / cost_done_;
-      double elapsed = std::chrono::duration<double>(now - r.start).count();
-      rem += std::max(0.0, expect - elapsed) * cost_done_ / wall_done_;
-    }
-    return rem;
   }
 
   void start(CaseRow row) {
@@ -211,9 +203,7 @@ class Runner {
       const std::string status = store_.record_outcome(r.row.case_id, r.attempt_id, out, h5, r.row.params);
       if (status == "done" || status == "unstable") {
         ++finished_;
-        wall_done_ += out.wall_s;
-        cost_done_ += r.row.est_cost;
-        ++n_done_session_;
+        eta_.add_done(r.row.params.mesh_level(), r.row.est_cost, out.wall_s);
       } else if (status == "failed") {
         ++failed_;
         progress_.message("capsim campaign: case " + r.row.case_id + " (Ca=" +
@@ -234,8 +224,8 @@ class Runner {
   std::string runs_dir_, worker_, host_;
   std::map<pid_t, Running> running_;
   std::set<std::string> interrupted_;
-  int total_ = 0, finished_ = 0, failed_ = 0, queued_ = 0, n_done_session_ = 0;
-  double wall_done_ = 0, cost_done_ = 0;
+  int total_ = 0, finished_ = 0, failed_ = 0, queued_ = 0;
+  EtaModel eta_;  // wall seconds per estimated cost, per mesh level, of the cases finished in this run
 };
 
 /// After a manager crash: stop leftover workers, then ingest finished results or requeue.

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 
 namespace capsim::campaign {
@@ -14,6 +15,40 @@ std::string format_duration(double s) {
   else if (t >= 60) std::snprintf(buf, sizeof buf, "%ldm%02lds", t / 60, t % 60);
   else std::snprintf(buf, sizeof buf, "%lds", t);
   return buf;
+}
+
+void EtaModel::add_done(int mesh_level, double est_cost, double wall_s) {
+  if (!(est_cost > 0) || !(wall_s >= 0)) return;
+  auto& [w, c] = by_level_[mesh_level];
+  w += wall_s;
+  c += est_cost;
+  wall_ += wall_s;
+  cost_ += est_cost;
+}
+
+double EtaModel::expected_s(int mesh_level, double est_cost) const {
+  if (!(cost_ > 0)) return -1;
+  const auto it = by_level_.find(mesh_level);
+  const double ratio = it != by_level_.end() && it->second.second > 0 ? it->second.first / it->second.second
+                                                                      : wall_ / cost_;
+  return est_cost * ratio;
+}
+
+double EtaModel::remaining_s(const std::vector<std::pair<int, double>>& pending,
+                             const std::vector<std::tuple<int, double, double>>& running, int jobs) const {
+  if (!(cost_ > 0)) return -1;
+  double total = 0, longest = 0;
+  for (const auto& [level, est] : pending) {
+    const double e = expected_s(level, est);
+    total += e;
+    longest = std::max(longest, e);
+  }
+  for (const auto& [level, est, elapsed] : running) {
+    const double e = std::max(0.0, expected_s(level, est) - elapsed);
+    total += e;
+    longest = std::max(longest, e);
+  }
+  return std::max(total / std::max(1, jobs), longest);
 }
 
 Progress::Progress(std::string name) : name_(std::move(name)), tty_(isatty(STDERR_FILENO) == 1) {}

@@ -3,7 +3,11 @@
 /// @brief The campaign progress display on stderr: a redrawn line on a terminal, a plain log otherwise.
 
 #include <chrono>
+#include <map>
 #include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 namespace capsim::campaign {
 
@@ -37,6 +41,30 @@ class Progress {
   bool drawn_ = false;
   std::string last_;
   std::chrono::steady_clock::time_point last_time_{};
+};
+
+/// @brief The time a campaign still needs, from what its finished cases cost.
+///
+/// CaseParams::estimated_cost is a rough power law in the mesh level (32× per level, where whole cases measure
+/// 5–13×), so one ratio of measured wall time to estimated cost, taken over cheap cases that ran first
+/// (`--order shortest`, or a level-2 scan before level 3), misjudges the expensive rest by an order of
+/// magnitude. Each mesh level therefore keeps its own ratio; a level with no finished case yet borrows the
+/// ratio of all finished cases.
+class EtaModel {
+ public:
+  /// @brief Records a finished case: its level, estimated cost and measured wall seconds.
+  void add_done(int mesh_level, double est_cost, double wall_s);
+  /// @brief Expected wall seconds of a case of @p mesh_level with @p est_cost; < 0 before any case finished.
+  [[nodiscard]] double expected_s(int mesh_level, double est_cost) const;
+  /// @brief Seconds until the last case ends: the work of @p pending (level, est_cost) and what @p running
+  /// (level, est_cost, elapsed seconds) still needs, spread over @p jobs workers, but never less than the
+  /// longest single remainder (one long case does not split). < 0 before any case finished.
+  [[nodiscard]] double remaining_s(const std::vector<std::pair<int, double>>& pending,
+                                   const std::vector<std::tuple<int, double, double>>& running, int jobs) const;
+
+ private:
+  std::map<int, std::pair<double, double>> by_level_;  // level -> (wall seconds, estimated cost)
+  double wall_ = 0, cost_ = 0;
 };
 
 /// @brief "1h02m", "3m20s", "12s".

@@ -1,8 +1,9 @@
-// `capsim campaign run|submit|collect|status`: the campaign manager's command line.
+// `capsim campaign run|submit|collect|analyse|status`: the campaign manager's command line.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <string>
@@ -44,6 +45,25 @@ campaign::Table transitions_table(const std::vector<campaign::Transition>& rows)
                       sampled(r.ca_star_high), h, sampled(r.ca_h_low), sampled(r.ca_h_high), r.method, r.note});
   }
   return t;
+}
+
+// `capsim campaign analyse`: the stored transitions are what the analysis of the build that last ran a campaign
+// made of its cases; after a change of the analysis (e.g. a sphere has no Ca*), this refreshes them in place
+// without running anything. It takes the manager lock: not while a manager runs on the database.
+int analyse(const std::string& db_path, const std::string& name) {
+  if (!std::filesystem::is_regular_file(db_path)) throw BadInput(db_path + ": no such database");
+  campaign::ManagerLock lock(db_path);
+  auto store = campaign::Store::open_for_write(db_path);
+  const auto camps = store->campaigns(name);
+  if (camps.empty())
+    throw BadInput(db_path + (name.empty() ? ": no campaign in this database" : ": no campaign named '" + name + "'"));
+  for (const auto& c : camps) {
+    const bool done = campaign::reanalyse_campaign(*store, c.campaign_id);  // one transaction (save_transitions)
+    std::printf("campaign '%s': %s\n", c.name.c_str(), done ? "transitions recomputed" : "no stored spec, left as is");
+    if (auto tr = store->transitions(c.campaign_id); done && !tr.empty())
+      std::printf("%s", campaign::render(transitions_table(tr), campaign::Format::kMarkdown).c_str());
+  }
+  return 0;
 }
 
 int status(const std::string& db_path, const std::string& name) {
@@ -126,6 +146,12 @@ int campaign_command(const std::vector<std::string>& args) {
   collect->add_option("--db", col.db_path, "SQLite results database")->required();
   collect->add_option("--campaign", col.campaign, "only this campaign");
 
+  std::string analyse_db, analyse_name;
+  auto* an = app.add_subcommand("analyse",
+                                "recompute the transitions of each campaign (or one) with this build's analysis; runs no case");
+  an->add_option("--db", analyse_db, "SQLite results database")->required();
+  an->add_option("--campaign", analyse_name, "only this campaign");
+
   std::string status_db, status_name;
   auto* st = app.add_subcommand("status", "counts per status, failures, transitions of each campaign");
   st->add_option("--db", status_db, "SQLite results database")->required();
@@ -154,6 +180,7 @@ int campaign_command(const std::vector<std::string>& args) {
       return campaign::submit_campaign(sub);
     }
     if (*collect) return campaign::collect_campaign(col);
+    if (*an) return analyse(analyse_db, analyse_name);
     return status(status_db, status_name);
   } catch (const BadInput& e) {
     std::fprintf(stderr, "capsim campaign: error: %s\n", campaign::one_line(e.what()).c_str());

@@ -1,5 +1,7 @@
 #include "campaign/scheduler/campaign_runner.h"
 
+#include <nlohmann/json.hpp>
+
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/file.h>
@@ -258,6 +260,27 @@ std::vector<Transition> analyse_campaign(Store& store, std::int64_t campaign_id,
   estimate_errors(rows, groups, ErrorOptions{levels});
   store.save_transitions(campaign_id, rows);
   return rows;
+}
+
+bool reanalyse_campaign(Store& store, std::int64_t campaign_id) {
+  const auto spec_json = store.campaign_spec_json(campaign_id);
+  if (!spec_json) return false;
+  double threshold = 0.05;
+  std::string method = "grid";
+  std::vector<int> levels;
+  try {
+    auto j = nlohmann::json::parse(*spec_json);
+    threshold = j.at("analysis").at("D12_threshold").get<double>();
+    if (j.at("analysis").value("adaptive", false)) method = "adaptive";
+    if (j.at("analysis").contains("levels")) {
+      levels = j.at("analysis").at("levels").get<std::vector<int>>();
+      method = "multi-fidelity";
+    }
+  } catch (...) {
+    // A spec from before these keys: the defaults (threshold 0.05, one level, grid).
+  }
+  analyse_campaign(store, campaign_id, threshold, method, levels);
+  return true;
 }
 
 int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir,

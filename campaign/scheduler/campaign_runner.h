@@ -88,6 +88,11 @@ std::string prepare_case_folder(const CaseRow& row, const std::string& runs_dir)
 std::vector<Transition> analyse_campaign(Store& store, std::int64_t campaign_id, double d12_threshold,
                                          const std::string& method, const std::vector<int>& levels = {});
 
+/// @brief analyse_campaign with the criterion, method and levels of the spec the campaign was registered with
+/// (its stored spec JSON); false if the campaign has none. Used after a collection and by `capsim campaign
+/// analyse` (transitions of a database refreshed with this build's analysis, no case run).
+bool reanalyse_campaign(Store& store, std::int64_t campaign_id);
+
 /// @brief One adaptive round (analysis/refinement.h) within the campaign's max_cases budget; returns how many
 /// cases it added to the campaign (0: nothing left to refine).
 /// With [analysis] levels, the next phase of analysis/multi_fidelity.h that adds cases (answer-level rounds,

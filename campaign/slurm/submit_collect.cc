@@ -173,24 +173,7 @@ CollectCounts collect_pass(Store& store, std::optional<std::int64_t> campaign_id
 
 /// Recomputes the transitions of the campaigns whose results changed (as `campaign run` does at its end).
 void reanalyse(Store& store, const std::set<std::int64_t>& campaigns) {
-  for (auto id : campaigns) {
-    const auto spec_json = store.campaign_spec_json(id);
-    if (!spec_json) continue;
-    double threshold = 0.05;
-    std::string method = "grid";
-    std::vector<int> levels;
-    try {
-      auto j = nlohmann::json::parse(*spec_json);
-      threshold = j.at("analysis").at("D12_threshold").get<double>();
-      if (j.at("analysis").value("adaptive", false)) method = "adaptive";
-      if (j.at("analysis").contains("levels")) {
-        levels = j.at("analysis").at("levels").get<std::vector<int>>();
-        method = "multi-fidelity";
-      }
-    } catch (...) {
-    }
-    analyse_campaign(store, id, threshold, method, levels);
-  }
+  for (auto id : campaigns) reanalyse_campaign(store, id);
 }
 
 std::string summary(const CollectCounts& n, const QueueState& q) {

@@ -1,7 +1,10 @@
 // The order in which `campaign run` starts the queued cases (--order): by the cost estimate
-// t_end · 32^level / Ca, most expensive first (longest, the default) or cheapest first (shortest).
+// t_end · 32^level / Ca, most expensive first (longest, the default) or cheapest first (shortest); and
+// `campaign analyse`, which recomputes the stored transitions.
 #include <gtest/gtest.h>
 
+#include "campaign/scheduler/campaign_runner.h"
+#include "campaign/store/sqlite_db.h"
 #include "tests/campaign/test_util.h"
 
 namespace capsim::campaign::testing {
@@ -34,6 +37,40 @@ TEST(CampaignRunner, LongestFirstStartsTheSmallestCaFirst) {
 
 TEST(CampaignRunner, ShortestFirstStartsTheLargestCaFirst) {
   EXPECT_EQ(started_order("shortest"), "0.06\n0.05\n0.04\n0.03\n0.02\n0.01\n");
+}
+
+// `capsim campaign analyse` recomputes the stored transitions from the cases (after a change of the analysis,
+// a database is refreshed without running anything), and refuses while a manager holds the database.
+TEST(CampaignRunner, AnalyseRecomputesTheStoredTransitions) {
+  const std::string dir = fresh_dir("runner_analyse");
+  const std::string db = dir + "/study.db";
+  write_file(dir + "/c.toml", R"([campaign]
+name = "prolate"
+[defaults]
+mesh.level = 1
+[[grid]]
+aspect_ratio = [2.0]
+law = ["neo-hookean"]
+capillary_number = [0.1, 0.2, 0.3, 0.4]
+)");
+  ASSERT_EQ(sh(campaign_cmd("FAKE_STEPS=1", dir + "/c.toml", db, "--jobs 2")).code, 0);
+  const std::string before = sql(db, "SELECT ca_star_low, ca_h FROM transitions");
+  {
+    Db d(db, false, false);
+    d.exec("UPDATE transitions SET ca_star_low = 9, ca_h = 99");
+  }
+  ASSERT_NE(sql(db, "SELECT ca_star_low, ca_h FROM transitions"), before);
+  {
+    ManagerLock held(db);  // a manager running on the database
+    const auto busy = sh(exe() + " campaign analyse --db " + db);
+    EXPECT_EQ(busy.code, 2) << busy.out;
+    EXPECT_NE(busy.err.find("another campaign manager"), std::string::npos) << busy.err;
+  }
+  const auto r = sh(exe() + " campaign analyse --db " + db);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("campaign 'prolate': transitions recomputed"), std::string::npos) << r.out;
+  EXPECT_EQ(sql(db, "SELECT ca_star_low, ca_h FROM transitions"), before);
+  EXPECT_EQ(sh(exe() + " campaign analyse --db " + db + " --campaign nope").code, 2);
 }
 
 }  // namespace

@@ -109,6 +109,14 @@ inline int wait_child(pid_t pid, double timeout_s) {
   return -1000;
 }
 
+/// The campaign file most fake-worker tests share: a prolate NH capsule on level 1 at Ca 0.1-0.4 (the fake
+/// worker's truth there: a Ca* band at 0.2, CaH = 0.35), with @p axes added to the grid (e.g. a second axis)
+/// and @p more appended (e.g. an [analysis] table).
+inline std::string prolate_campaign(const std::string& name, const std::string& axes = "", const std::string& more = "") {
+  return "[campaign]\nname = \"" + name + "\"\n[defaults]\nmesh.level = 1\n[[grid]]\naspect_ratio = [2.0]\n"
+         "law = [\"neo-hookean\"]\n" + axes + "capillary_number = [0.1, 0.2, 0.3, 0.4]\n" + more;
+}
+
 /// A campaign command with the fake worker and extra environment.
 inline std::string campaign_cmd(const std::string& env, const std::string& file, const std::string& db,
                                 const std::string& extra = "") {

@@ -12,16 +12,7 @@ namespace {
 TEST(TransitionGroups, NumericsAxisGivesOneTransitionPerValue) {
   const std::string dir = fresh_dir("transition_groups");
   const std::string db = dir + "/study.db";
-  write_file(dir + "/g.toml", R"([campaign]
-name = "dt-axis"
-[defaults]
-mesh.level = 1
-[[grid]]
-aspect_ratio = [2.0]
-law = ["neo-hookean"]
-time.dt = [0.01, 0.02]
-capillary_number = [0.1, 0.2, 0.3, 0.4]
-)");
+  write_file(dir + "/g.toml", prolate_campaign("dt-axis", "time.dt = [0.01, 0.02]\n"));
   auto r = sh(campaign_cmd("FAKE_STEPS=1 FAKE_STEP_S=0.001", dir + "/g.toml", db, "--jobs 2"));
   ASSERT_EQ(r.code, 0) << r.err;
   auto t = sh(exe() + " query sql \"SELECT * FROM transitions ORDER BY group_key\" --db " + db + " --format json");
@@ -52,16 +43,7 @@ capillary_number = [0.1, 0.2, 0.3, 0.4]
 TEST(TransitionGroups, BendingAxisIsChosenWithBendingModulus) {
   const std::string dir = fresh_dir("transition_groups_bending");
   const std::string db = dir + "/study.db";
-  write_file(dir + "/g.toml", R"([campaign]
-name = "kb-axis"
-[defaults]
-mesh.level = 1
-[[grid]]
-aspect_ratio = [2.0]
-law = ["neo-hookean"]
-bending_modulus = [0.0, 1e-3]
-capillary_number = [0.1, 0.2, 0.3, 0.4]
-)");
+  write_file(dir + "/g.toml", prolate_campaign("kb-axis", "bending_modulus = [0.0, 1e-3]\n"));
   auto r = sh(campaign_cmd("FAKE_STEPS=1 FAKE_STEP_S=0.001", dir + "/g.toml", db, "--jobs 2"));
   ASSERT_EQ(r.code, 0) << r.err;
   auto q = sh(exe() + " query table1 --db " + db);

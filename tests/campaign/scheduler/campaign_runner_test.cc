@@ -44,15 +44,7 @@ TEST(CampaignRunner, ShortestFirstStartsTheLargestCaFirst) {
 TEST(CampaignRunner, AnalyseRecomputesTheStoredTransitions) {
   const std::string dir = fresh_dir("runner_analyse");
   const std::string db = dir + "/study.db";
-  write_file(dir + "/c.toml", R"([campaign]
-name = "prolate"
-[defaults]
-mesh.level = 1
-[[grid]]
-aspect_ratio = [2.0]
-law = ["neo-hookean"]
-capillary_number = [0.1, 0.2, 0.3, 0.4]
-)");
+  write_file(dir + "/c.toml", prolate_campaign("prolate"));
   ASSERT_EQ(sh(campaign_cmd("FAKE_STEPS=1", dir + "/c.toml", db, "--jobs 2")).code, 0);
   const std::string before = sql(db, "SELECT ca_star_low, ca_h FROM transitions");
   {

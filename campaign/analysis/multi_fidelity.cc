@@ -79,7 +79,22 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
     // Seed: the scan's brackets.
     const Transition ts = analyse_group(scan.key, scan.samples, o.d12_threshold);
     for (const auto& x : bracketing_ca(ts)) p.add(x);
-    if (!ts.ca_star_low) p.add(ts.ca_min_d12);
+    if (!ts.ca_star_low && ts.ca_min_d12) {
+      p.add(ts.ca_min_d12);
+      // No band on the scan level, but a minimum near the threshold (< 3×, as the refinement's bracketing):
+      // the band can lie between the minimum's scan neighbours (the oblate capsule with κ_b = 1e-3: 0.072 at
+      // Ca 0.08 and 0.074 at 0.1 on level 2, a band ≈ 0.01 wide between them), so they seed the answer level
+      // too instead of being reached by bisection from the far side.
+      const std::vector<double> ca = sampled_ca(scan);
+      const auto it = std::find_if(ca.begin(), ca.end(), [&](double c) { return same_ca(c, *ts.ca_min_d12); });
+      double best = 1e300;
+      for (const auto& s : scan.samples)
+        if (s.min_d12 && same_ca(s.ca, *ts.ca_min_d12)) best = *s.min_d12;
+      if (it != ca.end() && best < 3 * o.d12_threshold && !is_sphere(ts)) {
+        if (it != ca.begin()) p.add(*std::prev(it));
+        if (std::next(it) != ca.end()) p.add(*std::next(it));
+      }
+    }
 
     if (answer && !answer->samples.empty()) {
       const Transition ta = analyse_group(answer->key, answer->samples, o.d12_threshold);

@@ -12,7 +12,7 @@ namespace capsim::campaign {
 namespace {
 
 CaseSample fake(int level, double ca, const std::function<double(double)>& tau, const std::string& status = "done",
-                double dt = 0) {
+                double dt = 0, const std::function<double(double)>& d12 = nullptr) {
   CaseParams p = CaseParams::defaults();
   p.set("capsule.law", std::string("neo-hookean"));
   p.set("capsule.aspect_ratio", 0.5);
@@ -25,7 +25,7 @@ CaseSample fake(int level, double ca, const std::function<double(double)>& tau, 
   c.params = p;
   c.status = status;
   if (status == "done") {
-    c.min_d12 = 0.3;  // no Ca* band: only CaH matters here
+    c.min_d12 = d12 ? d12(ca) : 0.3;  // by default no Ca* band: only CaH matters
     c.max_tau_min = tau(ca);
     c.dt = dt > 0 ? dt : 0.02;
   }
@@ -54,6 +54,23 @@ TEST(MultiFidelity, TheAnswerLevelStartsFromTheScanBrackets) {
   const auto add = answer_level_round(group_cases(cases), kOptions, 100);
   // The scan's CaH bracket (0.2, 0.5), and the smallest min D12 (no Ca* band; every min D12 equal: the first).
   EXPECT_EQ(ca_at(add, 3), (std::vector<double>{0.1, 0.2, 0.5}));
+}
+
+TEST(MultiFidelity, AScanMinimumNearTheThresholdSeedsItsNeighbours) {
+  // The oblate capsule with κ_b = 1e-3 on level 2: no sample below 0.05, the smallest min D12 0.072 at Ca 0.08
+  // and 0.074 at 0.1, with the band between them. The answer level starts from both neighbours of the minimum.
+  const auto d12 = [](double ca) { return ca < 0.07 ? 0.2 : ca < 0.09 ? 0.072 : ca < 0.2 ? 0.074 : 0.36; };
+  const auto tau = [](double) { return 0.01; };  // CaH above the range: its bracket adds the largest Ca
+  std::vector<CaseSample> cases;
+  for (double ca : {0.06, 0.08, 0.1, 0.3}) cases.push_back(fake(2, ca, tau, "done", 0, d12));
+  auto add = answer_level_round(group_cases(cases), kOptions, 100);
+  EXPECT_EQ(ca_at(add, 3), (std::vector<double>{0.06, 0.08, 0.1, 0.3}));
+  // A minimum far above the threshold (0.3 everywhere but 0.2 at 0.08) seeds only itself.
+  cases.clear();
+  const auto flat = [](double ca) { return ca > 0.07 && ca < 0.09 ? 0.2 : 0.3; };
+  for (double ca : {0.06, 0.08, 0.1, 0.3}) cases.push_back(fake(2, ca, tau, "done", 0, flat));
+  add = answer_level_round(group_cases(cases), kOptions, 100);
+  EXPECT_EQ(ca_at(add, 3), (std::vector<double>{0.08, 0.3}));
 }
 
 TEST(MultiFidelity, TheAnswerLevelReBracketsWhereTheScanWasWrong) {

@@ -53,6 +53,10 @@ std::vector<std::optional<double>> bracketing_ca(const Transition& t) {
   return {t.ca_star_below, t.ca_star_low, t.ca_star_high, t.ca_star_above, t.ca_h_low, t.ca_h_high};
 }
 
+// Whether a group's smallest min D12 lies near enough the threshold (< 3×) that a band may hide between its
+// samples: the rule of the answer level's bracketing of the minimum and of the scan's seeding of it.
+bool minimum_near_threshold(double min_d12, double threshold) { return min_d12 < 3 * threshold; }
+
 std::vector<double> sampled_ca(const SampleGroup& g) {
   std::vector<double> ca;
   for (const auto& s : g.samples) ca.push_back(s.ca);
@@ -90,7 +94,7 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
       double best = 1e300;
       for (const auto& s : scan.samples)
         if (s.min_d12 && same_ca(s.ca, *ts.ca_min_d12)) best = *s.min_d12;
-      if (it != ca.end() && best < 3 * o.d12_threshold && !is_sphere(ts)) {
+      if (it != ca.end() && minimum_near_threshold(best, o.d12_threshold) && !is_sphere(ts)) {
         if (it != ca.begin()) p.add(*std::prev(it));
         if (std::next(it) != ca.end()) p.add(*std::next(it));
       }
@@ -139,7 +143,7 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
         for (const auto& s : answer->samples)
           if (s.min_d12) best = std::min(best, *s.min_d12);
         const BracketTolerances tol{e.ca_star_low.numerical.value_or(0), e.ca_star_high.numerical.value_or(0),
-                                    e.ca_h.numerical.value_or(0), best < 3 * o.d12_threshold};
+                                    e.ca_h.numerical.value_or(0), minimum_near_threshold(best, o.d12_threshold)};
         for (double x : propose_refinement(ta, answer->samples, o.ca_tolerance, tol, answer->case_ca)) p.add(x);
       }
     }

@@ -25,16 +25,15 @@ Transition analyse_group(Transition t, std::vector<Sample> samples, double thr) 
   std::vector<const Sample*> d12;
   for (const auto& s : samples)
     if (s.min_d12) d12.push_back(&s);
-  if (!d12.empty() && is_sphere(t)) {
-    const Sample* best = *std::min_element(d12.begin(), d12.end(),
-                                           [](const Sample* a, const Sample* b) { return *a->min_d12 < *b->min_d12; });
-    t.ca_min_d12 = best->ca;
+  const Sample* best = d12.empty() ? nullptr
+                                   : *std::min_element(d12.begin(), d12.end(), [](const Sample* a, const Sample* b) {
+                                       return *a->min_d12 < *b->min_d12;
+                                     });
+  if (best) t.ca_min_d12 = best->ca;
+  if (best && is_sphere(t)) {
     notes.push_back("a/b = 1: a sphere does not tumble, Ca* does not apply (smallest min_D12 " +
                     format_significant(*best->min_d12) + " at Ca=" + format_sampled(best->ca) + ")");
-  } else if (!d12.empty()) {
-    const Sample* best = *std::min_element(d12.begin(), d12.end(),
-                                           [](const Sample* a, const Sample* b) { return *a->min_d12 < *b->min_d12; });
-    t.ca_min_d12 = best->ca;
+  } else if (best) {
     int first = -1, last = -1;
     for (int i = 0; i < static_cast<int>(d12.size()); ++i)
       if (*d12[i]->min_d12 < thr) {

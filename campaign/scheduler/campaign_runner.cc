@@ -262,24 +262,26 @@ std::vector<Transition> analyse_campaign(Store& store, std::int64_t campaign_id,
   return rows;
 }
 
+// The `method` column of the transitions: how the campaign chose its samples.
+static std::string analysis_method(bool adaptive, bool multi_fidelity) {
+  return multi_fidelity ? "multi-fidelity" : adaptive ? "adaptive" : "grid";
+}
+
 bool reanalyse_campaign(Store& store, std::int64_t campaign_id) {
   const auto spec_json = store.campaign_spec_json(campaign_id);
   if (!spec_json) return false;
   double threshold = 0.05;
-  std::string method = "grid";
+  bool adaptive = false;
   std::vector<int> levels;
   try {
     auto j = nlohmann::json::parse(*spec_json);
     threshold = j.at("analysis").at("D12_threshold").get<double>();
-    if (j.at("analysis").value("adaptive", false)) method = "adaptive";
-    if (j.at("analysis").contains("levels")) {
-      levels = j.at("analysis").at("levels").get<std::vector<int>>();
-      method = "multi-fidelity";
-    }
+    adaptive = j.at("analysis").value("adaptive", false);
+    if (j.at("analysis").contains("levels")) levels = j.at("analysis").at("levels").get<std::vector<int>>();
   } catch (...) {
     // A spec from before these keys: the defaults (threshold 0.05, one level, grid).
   }
-  analyse_campaign(store, campaign_id, threshold, method, levels);
+  analyse_campaign(store, campaign_id, threshold, analysis_method(adaptive, !levels.empty()), levels);
   return true;
 }
 
@@ -445,7 +447,7 @@ int run_campaign(const RunOptions& opt, const BeforeRun& before_run) {
                  std::to_string(jobs) + " job(s) x " + std::to_string(threads) + " thread(s), database " + opt.db_path);
 
   bool completed = runner.run_queued();
-  const std::string method = !spec.analysis.levels.empty() ? "multi-fidelity" : spec.analysis.adaptive ? "adaptive" : "grid";
+  const std::string method = analysis_method(spec.analysis.adaptive, !spec.analysis.levels.empty());
   if (completed && (spec.analysis.adaptive || !spec.analysis.levels.empty())) {
     // Multi-fidelity: max_rounds answer-level rounds, then the check level and the dt check (two more).
     const int rounds = spec.analysis.max_rounds + (spec.analysis.levels.empty() ? 0 : 2);

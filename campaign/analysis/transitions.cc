@@ -161,4 +161,25 @@ std::vector<Transition> analyse_groups(const std::vector<SampleGroup>& groups, d
   return rows;
 }
 
+std::string level_answers_json(const std::map<std::string, std::map<int, double>>& answers) {
+  if (answers.empty()) return "";
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [answer, by_level] : answers)
+    for (const auto& [level, x] : by_level) j[answer][std::to_string(level)] = x;
+  return j.dump();
+}
+
+std::map<std::string, std::map<int, double>> level_answers_from_json(const std::string& text) {
+  std::map<std::string, std::map<int, double>> out;
+  if (text.empty()) return out;
+  const auto j = nlohmann::json::parse(text, nullptr, false);
+  if (!j.is_object()) return out;  // written by save_transitions only; a hand-edited row reads as none
+  for (const auto& [answer, by_level] : j.items())
+    if (by_level.is_object())
+      for (const auto& [level, x] : by_level.items())
+        if (x.is_number() && !level.empty() && level.find_first_not_of("0123456789") == std::string::npos)
+          out[answer][std::stoi(level)] = x.get<double>();
+  return out;
+}
+
 }  // namespace capsim::campaign

@@ -6,6 +6,7 @@
 /// Pure computation on values: the store reads the cases (CaseSample) and saves the rows (Transition); this
 /// folder never touches the database, so the store may use these types without a cycle (store -> analysis).
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -44,6 +45,9 @@ struct Transition {
   std::string ca_star_low_err_source, ca_star_high_err_source, ca_h_err_source;
   std::string error_levels;  ///< mesh levels whose values entered the mesh part, e.g. "2,3"
   std::string error_note;    ///< provenance: every part of every error and how it was obtained
+  /// @brief Each answer ("ca_star_low", "ca_star_high", "ca_h") on the other levels its mesh error compared
+  /// (level -> value in Ca; AnswerError::on_level): e.g. the check level's value of an error check.
+  std::map<std::string, std::map<int, double>> level_answers;
 };
 
 /// @brief True for an initially spherical capsule (a/b = 1). It does not tumble, so the seed's Ca* (the
@@ -51,6 +55,12 @@ struct Transition {
 /// Ca -> 0 simply because a sphere at rest has D12 = 0 (with bending stiffness the sphere's level-3 min D12
 /// is below 0.15 already at Ca = 0.03), which is no transition.
 bool is_sphere(const Transition& t);
+
+/// @brief Transition::level_answers as stored (transitions.level_answers, schema 5) and printed by
+/// `capsim query table1 --format json`: {"ca_h": {"2": 0.2312, "4": 0.6031}, ...}, full precision; "" when empty.
+std::string level_answers_json(const std::map<std::string, std::map<int, double>>& answers);
+/// @brief The inverse of level_answers_json; "" or text that is not such an object reads as none.
+std::map<std::string, std::map<int, double>> level_answers_from_json(const std::string& text);
 
 /// @brief One finished case of a group.
 struct Sample {

@@ -45,6 +45,7 @@ std::string num(double x) { return format_significant(x, 2); }
 struct Part {
   std::optional<double> e;
   std::string how;
+  std::map<int, double> on_level;  // mesh part: the answer on the other levels it compared (level -> Ca)
 };
 
 // The cell of group `self`: the other groups by level (non dt_check) and the dt_check groups at its level.
@@ -115,8 +116,8 @@ Part mesh_part(const Cell& cell, int level, Answer which, double a, double b, do
   Part p;
   if (coarse) levels_used.insert(level - 1);
   if (fine) levels_used.insert(level + 1);
-  // "level L: x" (4 significant digits) is also read back: `scripts/table1 --error-check` takes the check
-  // level's value from this text in the stored error_note. Keep the form, or change both.
+  if (coarse) p.on_level[level - 1] = *coarse;
+  if (fine) p.on_level[level + 1] = *fine;
   auto text = [](int l, double x) { return "level " + std::to_string(l) + ": " + format_significant(x, 4); };
   if (coarse && fine) {
     const double d1 = here - *coarse, d2 = *fine - here;
@@ -168,7 +169,7 @@ Parts parts_at(const Cell& cell, const SampleGroup& g, const std::vector<const S
   Parts out;
   for (const Sample* c : cases)
     if (auto sp = spread(*c, q); sp && (!out.periods.e || *sp > *out.periods.e))
-      out.periods = {sp, "spread over the last periods at Ca " + format_sampled(c->ca)};
+      out.periods = {sp, "spread over the last periods at Ca " + format_sampled(c->ca), {}};
   out.dt = dt_part(cell, g, q);
   return out;
 }
@@ -182,6 +183,7 @@ void to_ca(const Parts& parts, double slope, Quantity q, AnswerError& e) {
       e.source = name;
     }
   };
+  e.on_level = parts.mesh.on_level;
   if (parts.mesh.e) {
     e.mesh = parts.mesh.e;
     how += "; mesh " + num(*e.mesh) + " (" + parts.mesh.how + ")";
@@ -350,6 +352,10 @@ void estimate_errors(std::vector<Transition>& rows, const std::vector<SampleGrou
     add("CaH", e.ca_h);
     add("Ca* low", e.ca_star_low);
     add("Ca* high", e.ca_star_high);
+    t.level_answers.clear();
+    if (!e.ca_h.on_level.empty()) t.level_answers["ca_h"] = e.ca_h.on_level;
+    if (!e.ca_star_low.on_level.empty()) t.level_answers["ca_star_low"] = e.ca_star_low.on_level;
+    if (!e.ca_star_high.on_level.empty()) t.level_answers["ca_star_high"] = e.ca_star_high.on_level;
   }
 }
 

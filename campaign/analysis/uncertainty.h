@@ -40,6 +40,7 @@
 /// A part that has no data (no other level, periods not recorded, no dt_check) is left out and said so in
 /// the note; with no part at all a CaH error is unknown (nullopt) and a Ca* edge's error is its gap.
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -67,6 +68,9 @@ struct AnswerError {
   std::optional<double> mesh, periods, dt;        ///< each part in Ca
   std::string source;                             ///< "mesh" | "periods" | "dt" | "bracket" | ""
   std::string how;                                ///< one line: the parts and how each was obtained
+  /// @brief The same answer on the other levels of the cell that the mesh part compared (level -> Ca;
+  /// for a Ca* edge the threshold crossing at the bracket, see the file comment): what a check level says.
+  std::map<int, double> on_level;
 };
 
 /// @brief The errors of the three answers of one group.

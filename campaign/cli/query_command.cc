@@ -97,14 +97,15 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
     campaign::Table t;
     t.columns = {"law",          "aspect_ratio",     "ca_star_low", "ca_star_high", "ca_h",
                  "ca_star_low_err", "ca_star_high_err", "ca_h_err",    "mesh_level",   "error_levels",
-                 "ca_star_low_err_source", "ca_star_high_err_source", "ca_h_err_source", "bending_modulus"};
+                 "ca_star_low_err_source", "ca_star_high_err_source", "ca_h_err_source", "bending_modulus", "level_answers"};
+    t.json_columns = {"level_answers"};  // {"ca_h": {"2": 0.23, "4": 0.61}, ...}: nested in JSON output
     auto text_or_null = [](const std::string& x) { return x.empty() ? SqlValue{nullptr} : SqlValue{x}; };
     for (const auto& r : rows)
       t.rows.push_back({r.law, r.aspect_ratio, value_of(r.ca_star_low), value_of(r.ca_star_high), value_of(r.ca_h),
                         value_of(r.ca_star_low_err), value_of(r.ca_star_high_err), value_of(r.ca_h_err),
                         std::int64_t{r.mesh_level}, text_or_null(r.error_levels), text_or_null(r.ca_star_low_err_source),
                         text_or_null(r.ca_star_high_err_source), text_or_null(r.ca_h_err_source),
-                        bending_modulus_of(r.group_key)});
+                        bending_modulus_of(r.group_key), text_or_null(campaign::level_answers_json(r.level_answers))});
     std::printf("%s", campaign::render(t, fmt).c_str());
     return 0;
   }

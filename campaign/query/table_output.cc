@@ -1,5 +1,7 @@
 #include "campaign/query/table_output.h"
 
+#include <algorithm>
+
 #include <nlohmann/json.hpp>
 
 #include "campaign/common/bad_input.h"
@@ -25,6 +27,9 @@ std::string render(const Table& t, Format f) {
   std::string out;
   if (f == Format::kJson) {
     nlohmann::ordered_json arr = nlohmann::ordered_json::array();
+    auto is_json = [&](const std::string& c) {
+      return std::find(t.json_columns.begin(), t.json_columns.end(), c) != t.json_columns.end();
+    };
     for (const auto& row : t.rows) {
       nlohmann::ordered_json o = nlohmann::ordered_json::object();
       for (std::size_t c = 0; c < t.columns.size(); ++c) {
@@ -32,6 +37,9 @@ std::string render(const Table& t, Format f) {
         if (std::holds_alternative<std::nullptr_t>(v)) o[t.columns[c]] = nullptr;
         else if (auto* i = std::get_if<std::int64_t>(&v)) o[t.columns[c]] = *i;
         else if (auto* d = std::get_if<double>(&v)) o[t.columns[c]] = *d;
+        else if (auto j = nlohmann::ordered_json::parse(std::get<std::string>(v), nullptr, false);
+                 is_json(t.columns[c]) && !j.is_discarded())
+          o[t.columns[c]] = std::move(j);
         else o[t.columns[c]] = std::get<std::string>(v);
       }
       arr.push_back(std::move(o));

@@ -34,6 +34,8 @@ class Db;
 struct Table {
   std::vector<std::string> columns;             ///< column names (JSON keys)
   std::vector<std::vector<SqlValue>> rows;      ///< one vector per row, same length as columns
+  /// @brief Columns whose text is a JSON document: JSON output nests it (Markdown and CSV print the text).
+  std::vector<std::string> json_columns;
 };
 
 /// @brief A prepared statement; bind with bind(i, v) (1-based), step() until it returns false.

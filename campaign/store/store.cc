@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <map>
+
 #include <nlohmann/json.hpp>
 #include <regex>
 
@@ -478,8 +480,8 @@ void Store::save_transitions(std::int64_t campaign_id, const std::vector<Transit
                            "d12_threshold,n_samples,ca_star_low,ca_star_high,ca_star_below,ca_star_above,ca_min_d12,"
                            "ca_h,ca_h_low,ca_h_high,ca_h_low_case,ca_h_high_case,method,note,role,ca_star_low_err,"
                            "ca_star_high_err,ca_h_err,ca_star_low_err_source,ca_star_high_err_source,ca_h_err_source,"
-                           "error_levels,error_note,updated_at) "
-                           "VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,") + kNow + ")");
+                           "error_levels,error_note,level_answers,updated_at) "
+                           "VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,") + kNow + ")");
   auto opt_text = [](const std::string& x) { return x.empty() ? SqlValue{nullptr} : SqlValue{x}; };
   for (const auto& r : rows) {
     s.reset();
@@ -492,6 +494,7 @@ void Store::save_transitions(std::int64_t campaign_id, const std::vector<Transit
     s.bind_opt(23, r.ca_star_high_err).bind_opt(24, r.ca_h_err).bind(25, opt_text(r.ca_star_low_err_source));
     s.bind(26, opt_text(r.ca_star_high_err_source)).bind(27, opt_text(r.ca_h_err_source));
     s.bind(28, opt_text(r.error_levels)).bind(29, r.error_note);
+    s.bind(30, opt_text(level_answers_json(r.level_answers)));
     s.step();
   }
   t.commit();
@@ -515,6 +518,7 @@ std::vector<CaseSample> Store::campaign_samples(std::int64_t campaign_id) {
 std::vector<Transition> Store::transitions(std::int64_t campaign_id, int mesh_level, double skalak_C) {
   const bool grouped = has_column(*db_, "transitions", "group_key");
   const bool with_errors = has_column(*db_, "transitions", "role");  // schema 4
+  const bool with_level_answers = has_column(*db_, "transitions", "level_answers");  // schema 5
   Stmt s(*db_, std::string("SELECT ") + (grouped ? "group_key" : "''") +
                    ", law, aspect_ratio, skalak_C, mesh_level, d12_threshold, n_samples, ca_star_low, ca_star_high, "
                    "ca_star_below, ca_star_above, ca_min_d12, ca_h, ca_h_low, ca_h_high, coalesce(ca_h_low_case,''), "
@@ -523,6 +527,7 @@ std::vector<Transition> Store::transitions(std::int64_t campaign_id, int mesh_le
                                   "coalesce(ca_star_high_err_source,''), coalesce(ca_h_err_source,''), "
                                   "coalesce(error_levels,''), error_note"
                                 : "'answer', NULL, NULL, NULL, '', '', '', '', ''") +
+                   (with_level_answers ? ", coalesce(level_answers,'')" : ", ''") +
                    " FROM transitions WHERE campaign_id=?1 "
                    "AND (?2 < 0 OR mesh_level = ?2) AND (?3 < -0.5 OR skalak_C = ?3 OR law='neo-hookean') "
                    "ORDER BY law, aspect_ratio, mesh_level DESC, 1");
@@ -558,6 +563,7 @@ std::vector<Transition> Store::transitions(std::int64_t campaign_id, int mesh_le
     t.ca_h_err_source = s.text(25);
     t.error_levels = s.text(26);
     t.error_note = s.text(27);
+    t.level_answers = level_answers_from_json(s.text(28));
     out.push_back(std::move(t));
   }
   return out;

@@ -110,6 +110,12 @@ TEST(Uncertainty, ThreeLevelsGiveTheDistanceToTheLimitByRichardson) {
   EXPECT_EQ(t.ca_h_err_source, "mesh");
   EXPECT_EQ(t.error_levels, "2,3,4");
   EXPECT_NE(t.error_note.find("observed order 1"), std::string::npos) << t.error_note;
+  // The neighbouring levels' answers it compared, at full precision (what an error check reads).
+  ASSERT_EQ(t.level_answers.count("ca_h"), 1u);
+  const auto& on = t.level_answers.at("ca_h");
+  ASSERT_EQ(on.size(), 2u);
+  EXPECT_NEAR(on.at(2), cah(2), 1e-14);
+  EXPECT_NEAR(on.at(4), cah(4), 1e-14);
   EXPECT_EQ(a.at(2, "scan").role, "scan");
   EXPECT_EQ(a.at(4, "mesh_check").role, "mesh_check");
 }

@@ -112,6 +112,12 @@ max_rounds = 20
   auto q = sh(exe() + " query table1 --db " + dir + "/two.db --format json");
   ASSERT_EQ(q.code, 0) << q.err;
   write_file(dir + "/two.json", q.out);
+  // The answer's value on the other level its mesh error compared, at full precision: level 1's CaH, one
+  // error (the level 1 -> 2 difference) below the level-2 answer.
+  const auto two = nlohmann::json::parse(q.out);
+  ASSERT_TRUE(two[0]["level_answers"].is_object()) << q.out;
+  EXPECT_NEAR(two[0]["level_answers"]["ca_h"]["1"].get<double>(),
+              two[0]["ca_h"].get<double>() - two[0]["ca_h_err"].get<double>(), 1e-12) << q.out;
   const std::string table1 = "/usr/bin/python3 " + std::string(CAPSIM_SOURCE_DIR) + "/scripts/table1";
   auto r = sh(table1 + " --db " + dir + "/three.db --error-check " + dir + "/two.json");
   ASSERT_EQ(r.code, 0) << r.err;
@@ -128,6 +134,11 @@ max_rounds = 20
   r = sh(table1 + " --db " + dir + "/two.db --error-check " + dir + "/two.json");
   EXPECT_NE(r.out.find("nothing to check"), std::string::npos) << r.out;
   EXPECT_EQ(sh(table1 + " --json " + dir + "/two.json --error-check " + dir + "/two.json").code, 2);
+  // Transitions analysed before the level values were stored (schema 4) are refused with what to do.
+  ASSERT_EQ(sh("sqlite3 " + dir + "/three.db 'UPDATE transitions SET level_answers = NULL'").code, 0);
+  r = sh(table1 + " --db " + dir + "/three.db --error-check " + dir + "/two.json");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("capsim campaign analyse"), std::string::npos) << r.err;
 }
 
 }  // namespace

@@ -330,16 +330,16 @@ TEST(SlurmSubmit, SchemaVersion1IsReadAsIsAndMigratedByAWriter) {
   FakeSlurm f(dir);
   r = sh(f.env() + exe() + " campaign collect --db " + db);
   EXPECT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(sql(db, "PRAGMA user_version"), "4\n");
+  EXPECT_EQ(sql(db, "PRAGMA user_version"), "5\n");
   EXPECT_EQ(sql(db, "SELECT count(*) FROM slurm_jobs"), "0\n");
   EXPECT_EQ(sql(db, "SELECT value FROM meta WHERE key='migrated_from'"), "1\n");
   EXPECT_EQ(sql(db, "SELECT * FROM results ORDER BY 1"), results);
   EXPECT_EQ(sql(db, "PRAGMA integrity_check"), "ok\n");
   // A newer version is refused.
-  r = sh("sqlite3 " + db + " 'PRAGMA user_version = 5;'");
+  r = sh("sqlite3 " + db + " 'PRAGMA user_version = 6;'");
   r = sh(f.env() + exe() + " campaign collect --db " + db);
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("schema version 5"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("schema version 6"), std::string::npos) << r.err;
 }
 
 }  // namespace

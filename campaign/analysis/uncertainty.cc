@@ -104,20 +104,66 @@ std::optional<double> level_answer(const SampleGroup& g2, Answer which, double a
   return crossing(*in, *y_in, *out, *y_out, thr);
 }
 
+// The largest |q_L2(c) − q_L(c)| over the bracket Ca c ∈ {a, b} where both groups have q (nullopt: none).
+std::optional<double> value_difference(const SampleGroup& g2, const SampleGroup& g, Quantity q, double a, double b) {
+  std::optional<double> out;
+  for (const auto& s2 : g2.samples)
+    for (const auto& s : g.samples)
+      if (same_ca(s2.ca, s.ca) && (same_ca(s.ca, a) || same_ca(s.ca, b)) && value(s2, q) && value(s, q)) {
+        const double d = std::fabs(*value(s2, q) - *value(s, q));
+        if (!out || d > *out) out = d;
+      }
+  return out;
+}
+
 // The mesh part of an answer, directly in Ca: the answer level's own value `here` against the neighbouring
-// levels' answers (Richardson with three monotone levels, else the last difference).
-Part mesh_part(const Cell& cell, int level, Answer which, double a, double b, double here, double thr,
+// levels' answers (Richardson with three monotone levels, else the last difference). A neighbour whose line
+// through the bracket samples crosses the target more than a bracket width outside the bracket [a, b] (its
+// values do not straddle the target and the line is nearly flat: an oblate capsule whose coarse level has no
+// band there) says nothing about where level L's crossing is; it is compared as values instead: the largest
+// |Δq| at the bracket samples over |slope| (slope of q on level L), as the periods and dt parts are.
+Part mesh_part(const Cell& cell, int level, Answer which, double a, double b, double here, double thr, double slope,
                std::set<int>& levels_used) {
-  std::optional<double> coarse, fine;
-  if (auto it = cell.by_level.find(level - 1); it != cell.by_level.end())
-    coarse = level_answer(*it->second, which, a, b, thr);
-  if (auto it = cell.by_level.find(level + 1); it != cell.by_level.end())
-    fine = level_answer(*it->second, which, a, b, thr);
+  const Quantity q = which == Answer::kCaH ? Quantity::kMaxTauMin : Quantity::kMinD12;
+  const double lo = std::min(a, b), hi = std::max(a, b), width = hi - lo;
+  auto far = [&](double x) { return x < lo - width || x > hi + width; };
+  std::optional<double> coarse, fine, far_e;
+  std::string far_how;
+  std::set<int> far_level;
+  auto take = [&](int l, std::optional<double>& out) {
+    auto it = cell.by_level.find(l);
+    if (it == cell.by_level.end()) return;
+    out = level_answer(*it->second, which, a, b, thr);
+    // Only a crossing extrapolated from that level's own samples at a and b can be "far" (a scan level's
+    // own answer from its own bracket elsewhere is a real mesh difference, however large).
+    bool at_both = false, at_a = false, at_b = false;
+    for (const auto& s2 : it->second->samples)
+      if (value(s2, q)) at_a |= same_ca(s2.ca, a), at_b |= same_ca(s2.ca, b);
+    at_both = at_a && at_b;
+    if (!out || !at_both || !far(*out)) return;
+    far_level.insert(l);
+    const auto d = value_difference(*it->second, *cell.by_level.at(level), q, a, b);
+    if (d && std::fabs(slope) > 0 && std::isfinite(slope)) {
+      const double e = *d / std::fabs(slope);
+      if (!far_e || e > *far_e) {
+        far_e = e;
+        far_how = "level " + std::to_string(l) + " crosses far outside the bracket (at " + format_significant(*out, 4) +
+                  "): " + name_of(q) + " differs by " + num(*d) + " at the bracket samples, over |slope| " +
+                  num(std::fabs(slope));
+      }
+    }
+    levels_used.insert(l);
+    // kept in on_level (what that level says), left out of the comparison in Ca below
+  };
+  take(level - 1, coarse);
+  take(level + 1, fine);
   Part p;
-  if (coarse) levels_used.insert(level - 1);
-  if (fine) levels_used.insert(level + 1);
   if (coarse) p.on_level[level - 1] = *coarse;
   if (fine) p.on_level[level + 1] = *fine;
+  if (coarse && far_level.count(level - 1)) coarse.reset();
+  if (fine && far_level.count(level + 1)) fine.reset();
+  if (coarse) levels_used.insert(level - 1);
+  if (fine) levels_used.insert(level + 1);
   auto text = [](int l, double x) { return "level " + std::to_string(l) + ": " + format_significant(x, 4); };
   if (coarse && fine) {
     const double d1 = here - *coarse, d2 = *fine - here;
@@ -136,6 +182,10 @@ Part mesh_part(const Cell& cell, int level, Answer which, double a, double b, do
   } else if (coarse) {
     p.e = std::fabs(here - *coarse);
     p.how = "difference to level " + std::to_string(level - 1) + " (" + text(level - 1, *coarse) + ")";
+  }
+  if (far_e && (!p.e || *far_e > *p.e)) {
+    p.e = far_e;
+    p.how = far_how;
   }
   return p;
 }
@@ -235,7 +285,8 @@ AnswerError ca_h_error(const Transition& t, const Cell& cell, const SampleGroup&
     return e;
   }
   Parts parts = parts_at(cell, g, {s[a], s[a + 1]}, Quantity::kMaxTauMin);
-  parts.mesh = mesh_part(cell, g.key.mesh_level, Answer::kCaH, s[a]->ca, s[a + 1]->ca, *t.ca_h, t.d12_threshold, levels);
+  parts.mesh = mesh_part(cell, g.key.mesh_level, Answer::kCaH, s[a]->ca, s[a + 1]->ca, *t.ca_h, t.d12_threshold,
+                         slope, levels);
   to_ca(parts, slope, Quantity::kMaxTauMin, e);
   e.total = e.numerical;
   return e;
@@ -269,7 +320,7 @@ AnswerError edge_error(const std::optional<double>& inside, const std::optional<
     Parts parts = parts_at(cell, g, {s[in], s[out]}, Quantity::kMinD12);
     if (here)
       parts.mesh = mesh_part(cell, g.key.mesh_level, low ? Answer::kCaStarLow : Answer::kCaStarHigh, s[in]->ca,
-                             s[out]->ca, *here, thr, levels);
+                             s[out]->ca, *here, thr, slope, levels);
     to_ca(parts, slope, Quantity::kMinD12, e);
   }
   e.total = e.bracket + e.numerical.value_or(0.0);

@@ -20,7 +20,11 @@
 ///   ratio r = d₂/d₁, e = |d₂| / (1 − r) (the distance from A_L to the extrapolated limit; observed order
 ///   p = log₂(1/r) since each level halves h). Otherwise the difference to the finer level |d₂|, or, with
 ///   only a coarser level, |d₁| — the coarse level's own error, an over-estimate of level L's when the mesh
-///   converges (it is what a two-level campaign can say).
+///   converges (it is what a two-level campaign can say). A neighbour whose line through its samples at the
+///   two bracket Ca crosses the target more than a bracket width outside the bracket (no crossing there: the
+///   oblate capsule with bending, whose level 2 has no band where level 3 has one) is compared as values
+///   instead: max |Δq| at the two samples over |slope| of q on level L (as the periods and dt parts); its
+///   crossing is still recorded in AnswerError::on_level.
 /// - **periods**: the spread of the quantity q (max τmin for CaH, min D12 for an edge) over the last periods
 ///   of the two bracketing cases (min_D12_period_spread, max_tau_min_period_spread of their results), the
 ///   larger of the two;

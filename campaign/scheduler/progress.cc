@@ -38,16 +38,21 @@ double EtaModel::remaining_s(const std::vector<std::pair<int, double>>& pending,
                              const std::vector<std::tuple<int, double, double>>& running, int jobs) const {
   if (!(cost_ > 0)) return -1;
   double total = 0, longest = 0;
+  bool overdue = false;
   for (const auto& [level, est] : pending) {
     const double e = expected_s(level, est);
     total += e;
     longest = std::max(longest, e);
   }
   for (const auto& [level, est, elapsed] : running) {
-    const double e = std::max(0.0, expected_s(level, est) - elapsed);
-    total += e;
+    const double e = expected_s(level, est) - elapsed;
+    overdue |= e <= 0;
+    total += std::max(0.0, e);
     longest = std::max(longest, e);
   }
+  // Only cases that already ran past their estimate are left: how much longer they take is not known
+  // (printing "0s" while they still run would be a wrong answer).
+  if (overdue && !(total > 0)) return -1;
   return std::max(total / std::max(1, jobs), longest);
 }
 

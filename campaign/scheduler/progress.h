@@ -58,7 +58,8 @@ class EtaModel {
   [[nodiscard]] double expected_s(int mesh_level, double est_cost) const;
   /// @brief Seconds until the last case ends: the work of @p pending (level, est_cost) and what @p running
   /// (level, est_cost, elapsed seconds) still needs, spread over @p jobs workers, but never less than the
-  /// longest single remainder (one long case does not split). < 0 before any case finished.
+  /// longest single remainder (one long case does not split). < 0 (printed "?") before any case finished,
+  /// and when all that is left is running cases that already ran past their estimate.
   [[nodiscard]] double remaining_s(const std::vector<std::pair<int, double>>& pending,
                                    const std::vector<std::tuple<int, double, double>>& running, int jobs) const;
 

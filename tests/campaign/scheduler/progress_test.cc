@@ -34,6 +34,9 @@ TEST(EtaModel, RemainingCountsThePendingWorkNotTheMeanOfWhatFinished) {
   // A running case counts what it still needs; one long case does not split between two workers.
   EXPECT_DOUBLE_EQ(m.remaining_s({}, {{3, 400.0, 50.0}}, 2), 150.0);
   EXPECT_DOUBLE_EQ(m.remaining_s({{2, 10.0}}, {{3, 400.0, 250.0}}, 2), 10.0);
+  // Only a case past its estimate left: unknown ("?"), not "0s" while it still runs.
+  EXPECT_LT(m.remaining_s({}, {{3, 400.0, 250.0}}, 2), 0);
+  EXPECT_EQ(format_duration(m.remaining_s({}, {{3, 400.0, 250.0}}, 2)), "?");
 }
 
 }  // namespace

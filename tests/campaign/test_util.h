@@ -109,6 +109,24 @@ inline int wait_child(pid_t pid, double timeout_s) {
   return -1000;
 }
 
+/// Waits up to @p timeout_s until @p n case folders under @p runs_dir hold the fake worker's checkpoint.txt
+/// (it writes one after each step, so such a worker has installed its signal trap and is computing); returns
+/// whether they do. Tests that signal a running campaign wait for this instead of sleeping a fixed time: on a
+/// loaded machine a fixed sleep can end before the workers have started (a flaky failure seen under ctest -j2).
+inline bool wait_for_checkpoints(const std::string& runs_dir, int n, double timeout_s) {
+  auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (std::chrono::steady_clock::now() < deadline) {
+    int found = 0;
+    std::error_code ec;
+    if (fs::is_directory(runs_dir, ec))
+      for (const auto& e : fs::directory_iterator(runs_dir, ec))
+        if (fs::exists(e.path() / "checkpoint.txt", ec)) ++found;
+    if (found >= n) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
 /// The campaign file most fake-worker tests share: a prolate NH capsule on level 1 at Ca 0.1-0.4 (the fake
 /// worker's truth there: a Ca* band at 0.2, CaH = 0.35), with @p axes added to the grid (e.g. a second axis)
 /// and @p more appended (e.g. an [analysis] table).

@@ -71,8 +71,9 @@ TEST(Faults, StopSignalCheckpointsWorkersAndRerunResumes) {
   for (int sig : {SIGTERM, SIGINT}) {
     fs::remove_all(dir + "/study.db.runs");
     fs::remove(db);
-    pid_t pid = spawn_sh(campaign_cmd("FAKE_STEPS=20 FAKE_STEP_S=0.05", dir + "/c.toml", db, "--jobs 2"));
-    std::this_thread::sleep_for(std::chrono::milliseconds(700));
+    // 100 steps of 0.05 s: no case finishes between the workers' first checkpoint and the signal.
+    pid_t pid = spawn_sh(campaign_cmd("FAKE_STEPS=100 FAKE_STEP_S=0.05", dir + "/c.toml", db, "--jobs 2"));
+    ASSERT_TRUE(wait_for_checkpoints(db + ".runs", 2, 30)) << "the two workers did not start";
     kill(pid, sig);
     EXPECT_EQ(wait_child(pid, 30), 3);  // interrupted
     auto interrupted = sql_csv(db, "SELECT count(*) FROM cases WHERE status='queued' AND resumable=1");
@@ -80,7 +81,7 @@ TEST(Faults, StopSignalCheckpointsWorkersAndRerunResumes) {
     EXPECT_EQ(sql_csv(db, "SELECT count(*) FROM cases WHERE status='running'"), "0\n");
     auto dry = sh(campaign_cmd("", dir + "/c.toml", db, "--dry-run"));
     EXPECT_NE(dry.out.find("resume from checkpoint"), std::string::npos) << dry.out;
-    auto r = sh(campaign_cmd("FAKE_STEPS=20 FAKE_STEP_S=0.01", dir + "/c.toml", db, "--jobs 2"));
+    auto r = sh(campaign_cmd("FAKE_STEPS=100 FAKE_STEP_S=0.002", dir + "/c.toml", db, "--jobs 2"));
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_EQ(sql_csv(db, "SELECT count(*) FROM results"), "12\n");
     EXPECT_EQ(sql_csv(db, "SELECT count(*) FROM attempts WHERE resumed=1 AND outcome='done'"), "2\n");
@@ -95,8 +96,8 @@ TEST(Faults, ACopyOfTheDatabaseNeverWritesIntoTheOriginalsCaseFolders) {
   const std::string dir = fresh_dir("faults_copy");
   const std::string db = dir + "/study.db";
   write_file(dir + "/c.toml", kTwelve);
-  pid_t pid = spawn_sh(campaign_cmd("FAKE_STEPS=20 FAKE_STEP_S=0.05", dir + "/c.toml", db, "--jobs 2"));
-  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  pid_t pid = spawn_sh(campaign_cmd("FAKE_STEPS=100 FAKE_STEP_S=0.05", dir + "/c.toml", db, "--jobs 2"));
+  ASSERT_TRUE(wait_for_checkpoints(db + ".runs", 2, 30)) << "the two workers did not start";
   kill(pid, SIGINT);
   ASSERT_EQ(wait_child(pid, 30), 3);  // interrupted: two resumable cases, the rest queued or done
   const auto before = folder_snapshot(db + ".runs");

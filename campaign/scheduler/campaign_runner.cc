@@ -321,6 +321,27 @@ int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& 
 
 namespace {
 
+/// The identities of the expanded grid under this build's solver version.
+std::set<std::string> grid_identities(const std::vector<CaseParams>& cases) {
+  const std::string version = solver_version();
+  std::set<std::string> ids;
+  for (const auto& p : cases) ids.insert(p.identity(version));
+  return ids;
+}
+
+/// "neo-hookean a/b 2 Ca 0.35 level 4 (queued), …" for up to four cases, then "and N more".
+std::string describe_cases(const std::vector<CaseRow>& rows) {
+  std::string out;
+  for (std::size_t i = 0; i < rows.size() && i < 4; ++i) {
+    const auto& p = rows[i].params;
+    out += (i ? ", " : "") + p.law() + " a/b " + canonical_double(p.aspect_ratio()) + " Ca " +
+           canonical_double(p.capillary_number()) + " level " + std::to_string(p.mesh_level()) + " (" +
+           rows[i].status + ")";
+  }
+  if (rows.size() > 4) out += " and " + std::to_string(rows.size() - 4) + " more";
+  return out;
+}
+
 int dry_run(const RunOptions& opt, const CampaignSpec& spec, const std::vector<CaseParams>& cases) {
   std::unique_ptr<Store> store;
   if (fs::exists(opt.db_path)) store = Store::open_readonly(opt.db_path);
@@ -346,7 +367,20 @@ int dry_run(const RunOptions& opt, const CampaignSpec& spec, const std::vector<C
                 canonical_double(p.aspect_ratio()).c_str(), canonical_double(p.capillary_number()).c_str(),
                 p.mesh_level(), action.c_str());
   }
-  std::printf("%zu cases: %d to run, %d to skip%s\n", cases.size(), counts["run"], counts["skip"],
+  int dropped = 0;
+  if (store) {
+    if (auto id = store->find_campaign(spec.name)) {
+      for (const auto& r : store->stale_grid_cases(*id, grid_identities(cases))) {
+        ++dropped;
+        std::printf("%-16s  %-11s  %-8s  %-6s  %-5d  %s\n", r.case_id.c_str(), r.params.law().c_str(),
+                    canonical_double(r.params.aspect_ratio()).c_str(),
+                    canonical_double(r.params.capillary_number()).c_str(), r.params.mesh_level(),
+                    ("unlink: no longer in the grid (" + r.status + "; stays in the database)").c_str());
+      }
+    }
+  }
+  std::printf("%zu cases: %d to run, %d to skip%s%s\n", cases.size(), counts["run"], counts["skip"],
+              dropped ? (", " + std::to_string(dropped) + " to unlink").c_str() : "",
               spec.analysis.adaptive ? " (adaptive mode may add more)" : "");
   return kRunComplete;
 }
@@ -408,6 +442,18 @@ PreparedCampaign prepare_campaign(const RunOptions& opt, const std::function<voi
     Transaction t(pc.store->db());
     pc.campaign_id = pc.store->upsert_campaign(pc.spec);
     pc.store->add_cases(pc.campaign_id, pc.cases, "grid", pc.runs_dir);
+    // The campaign is its file's grid plus what its analysis added: links an earlier version of the file made
+    // (a value since removed from an axis) go, or the run would start cases the dry run does not list and the
+    // analysis would read samples the file no longer asks for. The cases themselves stay in the database.
+    const auto stale = pc.store->stale_grid_cases(pc.campaign_id, grid_identities(pc.cases));
+    if (!stale.empty()) {
+      std::vector<std::string> ids;
+      for (const auto& r : stale) ids.push_back(r.case_id);
+      pc.store->unlink_cases(pc.campaign_id, ids);
+      log("capsim campaign: " + std::to_string(stale.size()) + " case(s) an earlier version of '" + pc.spec.name +
+          "' linked are no longer in its grid (" + describe_cases(stale) +
+          "): unlinked, not run and not analysed; their rows and results stay in the database");
+    }
     if (opt.retry_failed) pc.store->requeue_failed(pc.campaign_id);
     t.commit();
   }

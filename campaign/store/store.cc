@@ -333,6 +333,29 @@ CaseRow read_case(const Stmt& s) {
 }
 }  // namespace
 
+std::vector<CaseRow> Store::stale_grid_cases(std::int64_t campaign_id, const std::set<std::string>& grid_ids) {
+  Stmt s(*db_, std::string("SELECT ") + kCaseCols +
+                   " FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id WHERE cc.campaign_id=? "
+                   "AND cc.origin='grid' ORDER BY c.case_id");
+  s.bind(1, campaign_id);
+  std::vector<CaseRow> out;
+  while (s.step())
+    if (!grid_ids.count(s.text(0))) out.push_back(read_case(s));
+  return out;
+}
+
+int Store::unlink_cases(std::int64_t campaign_id, const std::vector<std::string>& case_ids) {
+  Stmt del(*db_, "DELETE FROM campaign_cases WHERE campaign_id=? AND case_id=?");
+  int n = 0;
+  for (const auto& id : case_ids) {
+    del.reset();
+    del.bind(1, campaign_id).bind(2, id);
+    del.step();
+    n += db_->changes();
+  }
+  return n;
+}
+
 std::vector<CaseRow> Store::campaign_cases(std::int64_t campaign_id) {
   Stmt s(*db_, std::string("SELECT ") + kCaseCols +
                    " FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id WHERE cc.campaign_id=? "

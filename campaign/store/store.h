@@ -10,6 +10,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -113,6 +114,12 @@ class Store {
                 const std::string& runs_dir);
   /// @brief Cases of a campaign.
   std::vector<CaseRow> campaign_cases(std::int64_t campaign_id);
+  /// @brief The cases linked to a campaign by its grid (origin "grid") that are not in @p grid_ids: what an
+  /// earlier version of its file linked (a value since removed from an axis, a changed default). By case id.
+  std::vector<CaseRow> stale_grid_cases(std::int64_t campaign_id, const std::set<std::string>& grid_ids);
+  /// @brief Removes the campaign's links to @p case_ids (the cases, their results and attempts stay in the
+  /// database, and other campaigns keep theirs); returns how many links went.
+  int unlink_cases(std::int64_t campaign_id, const std::vector<std::string>& case_ids);
   /// @brief The state of case @p case_id, nullopt if the database does not hold it.
   std::optional<CaseState> case_state(const std::string& case_id);
   /// @brief Every case with status running (orphans after a manager crash).

@@ -65,5 +65,43 @@ TEST(CampaignRunner, AnalyseRecomputesTheStoredTransitions) {
   EXPECT_EQ(sh(exe() + " campaign analyse --db " + db + " --campaign nope").code, 2);
 }
 
+// A campaign is its file's grid plus what its analysis added. Found when a campaign file was cut to one of its
+// cases and rerun: the dry run listed that one case, the run started another, the most expensive of the
+// earlier grid's queued cases. Links of an earlier grid that the file no longer has are now reported by the
+// dry run, unlinked by the run (not run, not analysed) and their cases kept in the database.
+TEST(CampaignRunner, ACaseRemovedFromTheGridIsNeitherRunNorAnalysedButStaysInTheDatabase) {
+  const std::string dir = fresh_dir("runner_stale_grid");
+  const std::string db = dir + "/study.db";
+  write_file(dir + "/c.toml", kSix);
+  // The six cases registered, none run: a stopped manager leaves them queued.
+  pid_t pid = spawn_sh(campaign_cmd("FAKE_STEPS=100 FAKE_STEP_S=0.05", dir + "/c.toml", db, "--jobs 1"));
+  ASSERT_TRUE(wait_for_checkpoints(db + ".runs", 1, 30));
+  kill(pid, SIGTERM);
+  ASSERT_EQ(wait_child(pid, 30), 3);
+  ASSERT_EQ(sql(db, "SELECT count(*) FROM campaign_cases"), "6\n");
+  // The file cut to two Ca values.
+  std::string two = kSix;
+  two.replace(two.find("[0.03, 0.01, 0.06, 0.02, 0.05, 0.04]"), 36, "[0.03, 0.05]");
+  write_file(dir + "/c.toml", two);
+  const auto dry = sh(campaign_cmd("", dir + "/c.toml", db, "--dry-run"));
+  ASSERT_EQ(dry.code, 0) << dry.err;
+  EXPECT_NE(dry.out.find("2 cases: 2 to run, 0 to skip, 4 to unlink"), std::string::npos) << dry.out;
+  EXPECT_EQ(count_lines(dry.out), 1 + 2 + 4 + 1) << dry.out;  // header, grid, unlinked, summary
+  const auto r = sh(campaign_cmd("FAKE_STEPS=1", dir + "/c.toml", db, "--jobs 1"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("4 case(s) an earlier version of 'six' linked are no longer in its grid"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(sql(db, "SELECT c.capillary_number FROM cases c JOIN results USING(case_id) ORDER BY 1"),
+            "0.03\n0.05\n");
+  EXPECT_EQ(sql(db, "SELECT count(*) FROM cases"), "6\n");  // kept
+  EXPECT_EQ(sql(db, "SELECT count(*) FROM campaign_cases"), "2\n");
+  EXPECT_EQ(sh(campaign_cmd("", dir + "/c.toml", db, "--dry-run")).out.find("to unlink"), std::string::npos);
+  // The full file again: the four are linked (and run) again.
+  write_file(dir + "/c.toml", kSix);
+  ASSERT_EQ(sh(campaign_cmd("FAKE_STEPS=1", dir + "/c.toml", db, "--jobs 1")).code, 0);
+  EXPECT_EQ(sql(db, "SELECT count(*) FROM campaign_cases"), "6\n");
+  EXPECT_EQ(sql(db, "SELECT count(*) FROM results"), "6\n");
+}
+
 }  // namespace
 }  // namespace capsim::campaign::testing

@@ -89,6 +89,38 @@ TEST(Faults, StopSignalCheckpointsWorkersAndRerunResumes) {
   }
 }
 
+// scripts/checkpoints carries the checkpoints of a stopped campaign to a clone without the case folders (they
+// are not committed): save, lose DB.runs, restore, rerun -> the two interrupted cases resume, not restart.
+TEST(Faults, CheckpointsCarriedByTheScriptResumeInAFreshRunsFolder) {
+  const std::string dir = fresh_dir("faults_carry");
+  const std::string db = dir + "/study.db";
+  const std::string script = std::string(CAPSIM_SOURCE_DIR) + "/scripts/checkpoints";
+  write_file(dir + "/c.toml", kTwelve);
+  pid_t pid = spawn_sh(campaign_cmd("FAKE_STEPS=100 FAKE_STEP_S=0.05", dir + "/c.toml", db, "--jobs 2"));
+  ASSERT_TRUE(wait_for_checkpoints(db + ".runs", 2, 30)) << "the two workers did not start";
+  kill(pid, SIGTERM);
+  ASSERT_EQ(wait_child(pid, 30), 3);
+  ASSERT_EQ(sql_csv(db, "SELECT count(*) FROM cases WHERE status='queued' AND resumable=1"), "2\n");
+  auto saved = sh(script + " save " + db);
+  ASSERT_EQ(saved.code, 0) << saved.err;
+  EXPECT_NE(saved.out.find("2 case folder(s)"), std::string::npos) << saved.out;
+  EXPECT_EQ(count_lines(sh(script + " list " + db).out), 2);
+  fs::remove_all(db + ".runs");  // the fresh clone
+  auto restored = sh(script + " restore " + db);
+  ASSERT_EQ(restored.code, 0) << restored.err;
+  EXPECT_NE(restored.out.find("2 case folder(s) restored"), std::string::npos) << restored.out;
+  auto r = sh(campaign_cmd("FAKE_STEPS=100 FAKE_STEP_S=0.002", dir + "/c.toml", db, "--jobs 2"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(sql_csv(db, "SELECT count(*) FROM attempts WHERE resumed=1 AND outcome='done'"), "2\n");
+  // Bad input: one message, exit 2, nothing changed.
+  EXPECT_EQ(sh(script + " restore " + dir + "/nope.db").code, 2);
+  EXPECT_EQ(sh(script + " frobnicate " + db).code, 2);
+  // Nothing resumable left: save says so and removes the stale archive; restore then has nothing to read.
+  ASSERT_EQ(sh(script + " save " + db).code, 0);
+  EXPECT_FALSE(fs::exists(db + ".checkpoints.tar.gz"));
+  EXPECT_EQ(sh(script + " restore " + db).code, 2);
+}
+
 // Found while a copy of a running campaign's database was analysed: the copy kept the original's absolute
 // case folders and its manager rewrote their case.toml and truncated a live worker's logs. A campaign run on
 // a copy must write only under its own runs folder.

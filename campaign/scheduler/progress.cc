@@ -1,5 +1,7 @@
 #include "campaign/scheduler/progress.h"
 
+#include <cmath>
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -29,9 +31,20 @@ void EtaModel::add_done(int mesh_level, double est_cost, double wall_s) {
 double EtaModel::expected_s(int mesh_level, double est_cost) const {
   if (!(cost_ > 0)) return -1;
   const auto it = by_level_.find(mesh_level);
-  const double ratio = it != by_level_.end() && it->second.second > 0 ? it->second.first / it->second.second
-                                                                      : wall_ / cost_;
-  return est_cost * ratio;
+  if (it != by_level_.end() && it->second.second > 0) return est_cost * it->second.first / it->second.second;
+  // No case of this level finished yet: the nearest level that has one (the coarser on a tie), corrected from
+  // the estimate's 32x per level to what whole cases measure per level.
+  int nearest = 0;
+  double ratio = -1;
+  for (const auto& [level, wc] : by_level_) {
+    if (!(wc.second > 0)) continue;
+    if (ratio < 0 || std::abs(level - mesh_level) < std::abs(nearest - mesh_level)) {
+      nearest = level;
+      ratio = wc.first / wc.second;
+    }
+  }
+  if (ratio < 0) ratio = wall_ / cost_;
+  return est_cost * ratio * std::pow(kMeasuredPerLevel / 32.0, mesh_level - nearest);
 }
 
 double EtaModel::remaining_s(const std::vector<std::pair<int, double>>& pending,

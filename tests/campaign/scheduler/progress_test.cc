@@ -20,8 +20,21 @@ TEST(EtaModel, EachLevelKeepsItsOwnRatio) {
   m.add_done(3, 40.0, 10.0);
   EXPECT_DOUBLE_EQ(m.expected_s(2, 5.0), 5.0);
   EXPECT_DOUBLE_EQ(m.expected_s(3, 80.0), 20.0);
-  // A level with no finished case borrows the ratio of all: 20 s per 50 units.
-  EXPECT_DOUBLE_EQ(m.expected_s(4, 100.0), 40.0);
+  // A level with no finished case borrows the nearest level's ratio (level 3: 0.25 s per unit), corrected from
+  // the estimate's 32x per level to the measured 9x: a level-4 case estimated at 32x a level-3 one of 10 s.
+  EXPECT_DOUBLE_EQ(m.expected_s(4, 1280.0), 1280.0 * 0.25 * 9.0 / 32.0);
+  EXPECT_DOUBLE_EQ(m.expected_s(4, 1280.0), EtaModel::kMeasuredPerLevel * 10.0);
+  EXPECT_DOUBLE_EQ(m.expected_s(1, 1.0), 1.0 * 32.0 / 9.0);  // coarser: the other way
+}
+
+// Found on a level-2/3 scan run cheapest first: with the level-2 cases done, the first level-3 cases were
+// expected to cost 32x their level-2 twins (the estimate's law) where whole cases measure ≈ 9x, and the ETA
+// read 8 h for about 1.5 h of work.
+TEST(EtaModel, TheFirstCasesOfAFinerLevelAreExpectedAtTheMeasuredFactorPerLevel) {
+  EtaModel m;
+  for (int i = 0; i < 8; ++i) m.add_done(2, 1.0, 60.0);  // eight level-2 cases of a minute each
+  EXPECT_DOUBLE_EQ(m.expected_s(3, 32.0), 9.0 * 60.0);
+  EXPECT_DOUBLE_EQ(m.remaining_s(std::vector<std::pair<int, double>>(8, {3, 32.0}), {}, 1), 8 * 9.0 * 60.0);
 }
 
 TEST(EtaModel, RemainingCountsThePendingWorkNotTheMeanOfWhatFinished) {

@@ -1,11 +1,13 @@
 // `capsim campaign run|submit|collect|analyse|status`: the campaign manager's command line.
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <cstdio>
 #include <exception>
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -17,6 +19,7 @@
 #include "campaign/scheduler/campaign_runner.h"
 #include "campaign/slurm/slurm.h"
 #include "campaign/store/store.h"
+#include "solver/config/case_keys.h"
 
 namespace capsim::cli {
 
@@ -24,12 +27,55 @@ namespace {
 
 using campaign::BadInput;
 
+// The identity keys, beyond those with a column (law, a/b, C, level), whose value differs between the groups
+// of a campaign — capsule.bending_modulus on a bending axis, time.dt of a dt/2 check: without them two rows
+// of the status table, or two problem cases, read the same.
+const std::set<std::string> kShownKeys = {"capsule.law", "capsule.aspect_ratio", "capsule.skalak_C", "mesh.level"};
+
+std::vector<std::string> varying_keys(const std::vector<std::string>& group_keys) {
+  std::map<std::string, std::set<std::string>> values;  // key -> the values it takes ("" where absent)
+  std::vector<nlohmann::json> parsed;
+  for (const auto& g : group_keys) {
+    parsed.push_back(nlohmann::json::parse(g, nullptr, false));
+    if (parsed.back().is_object())
+      for (const auto& [k, _] : parsed.back().items())
+        if (!kShownKeys.count(k)) values[k];
+  }
+  for (const auto& j : parsed) {
+    if (!j.is_object()) continue;  // a version-2 row: no group key
+    for (auto& [k, vs] : values) vs.insert(j.contains(k) ? j[k].dump() : "");
+  }
+  std::vector<std::string> out;
+  for (const auto& [k, vs] : values)
+    if (vs.size() > 1) out.push_back(k);
+  return out;
+}
+
+// "capsule.bending_modulus=0.001, time.dt=0.01" for @p keys of @p group_key (a key left at its default is not
+// in the group key: the registry's default is shown).
+std::string key_values(const std::string& group_key, const std::vector<std::string>& keys) {
+  const auto j = nlohmann::json::parse(group_key, nullptr, false);
+  std::string out;
+  for (const auto& k : keys) {
+    std::string v;
+    if (j.is_object() && j.contains(k)) v = j[k].is_string() ? j[k].get<std::string>() : j[k].dump();
+    else if (const auto* key = config::find_case_key(k)) v = config::shortest_text(key->default_value);
+    out += (out.empty() ? "" : ", ") + k + "=" + v;
+  }
+  return out;
+}
+
 // The transitions as `status` prints them: sampled Ca as sampled, CaH to the leading digit of its bracket
-// width (its error bound), no digit more (`capsim query sql` gives the stored values in full).
+// width (its error bound), no digit more (`capsim query sql` gives the stored values in full). A column
+// "group" names the other keys that tell the rows apart, where there are such.
 campaign::Table transitions_table(const std::vector<campaign::Transition>& rows) {
   campaign::Table t;
+  std::vector<std::string> groups;
+  for (const auto& r : rows) groups.push_back(r.group_key);
+  const auto keys = varying_keys(groups);
   t.columns = {"law", "aspect_ratio", "skalak_C", "mesh_level", "role", "n_samples", "ca_star_low", "ca_star_high",
                "ca_h", "ca_h_low", "ca_h_high", "method", "note"};
+  if (!keys.empty()) t.columns.insert(t.columns.begin() + 4, "group");
   auto sampled = [](const std::optional<double>& x) {
     return x ? campaign::SqlValue{campaign::format_sampled(*x)} : campaign::SqlValue{nullptr};
   };
@@ -43,6 +89,7 @@ campaign::Table transitions_table(const std::vector<campaign::Transition>& rows)
                       r.skalak_C < 0 ? campaign::SqlValue{nullptr} : campaign::SqlValue{campaign::format_sampled(r.skalak_C)},
                       std::int64_t{r.mesh_level}, r.role, std::int64_t{r.n_samples}, sampled(r.ca_star_low),
                       sampled(r.ca_star_high), h, sampled(r.ca_h_low), sampled(r.ca_h_high), r.method, r.note});
+    if (!keys.empty()) t.rows.back().insert(t.rows.back().begin() + 4, key_values(r.group_key, keys));
   }
   return t;
 }
@@ -77,12 +124,19 @@ int status(const std::string& db_path, const std::string& name) {
                 (long long)n.total, (long long)n.adaptive, (long long)n.by_status["done"],
                 (long long)n.by_status["unstable"], (long long)n.by_status["failed"], (long long)n.by_status["running"],
                 (long long)n.by_status["queued"]);
-    for (const auto& p : store->problem_cases(c.campaign_id, 50)) {
+    const auto problems = store->problem_cases(c.campaign_id, 50);
+    const auto tr = store->transitions(c.campaign_id);
+    std::vector<std::string> groups;
+    for (const auto& r : tr) groups.push_back(r.group_key);
+    for (const auto& p : problems) groups.push_back(p.group_key);
+    const auto keys = varying_keys(groups);
+    for (const auto& p : problems) {
       std::string err = p.error;
       if (err.size() > 160) err = err.substr(0, 157) + "...";
-      std::printf("  %-8s %s  %s a/b=%s Ca=%s  %s\n", p.status.c_str(), p.case_id.c_str(), p.law.c_str(),
+      const std::string more = keys.empty() ? "" : " " + key_values(p.group_key, keys);
+      std::printf("  %-8s %s  %s a/b=%s Ca=%s level %d%s  %s\n", p.status.c_str(), p.case_id.c_str(), p.law.c_str(),
                   campaign::canonical_double(p.aspect_ratio).c_str(), campaign::canonical_double(p.capillary_number).c_str(),
-                  err.c_str());
+                  p.mesh_level, more.c_str(), err.c_str());
     }
     // What each mesh level cost (a multi-fidelity campaign's saving is read here).
     if (const auto costs = store->level_costs(c.campaign_id); costs.size() > 1) {
@@ -92,8 +146,7 @@ int status(const std::string& db_path, const std::string& name) {
                     campaign::format_significant(l.core_s / 3600.0, 3).c_str());
       std::printf("\n");
     }
-    if (auto tr = store->transitions(c.campaign_id); !tr.empty())
-      std::printf("%s", campaign::render(transitions_table(tr), campaign::Format::kMarkdown).c_str());
+    if (!tr.empty()) std::printf("%s", campaign::render(transitions_table(tr), campaign::Format::kMarkdown).c_str());
     campaign::print_slurm_status(store->db(), c.campaign_id);
   }
   if (camps.empty()) {

@@ -70,6 +70,8 @@ struct StatusCounts {
 struct ProblemCase {
   std::string case_id, law, status, error;  ///< identity, law, status, last error
   double aspect_ratio = 0, capillary_number = 0;  ///< a/b, Ca
+  int mesh_level = 0;                       ///< mesh level
+  std::string group_key;                    ///< its transition group (analysis/transitions.h group_key)
 };
 
 /// @brief Filters of `capsim query cases` (empty / non-positive: no filter).

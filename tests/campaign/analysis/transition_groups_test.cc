@@ -62,5 +62,26 @@ TEST(TransitionGroups, BendingAxisIsChosenWithBendingModulus) {
   EXPECT_NE(q.err.find("no transitions with capsule.bending_modulus = 0.5"), std::string::npos) << q.err;
 }
 
+// campaign status tells the groups apart: its table had one row per group but no column for the key that
+// differs (two rows "neo-hookean 2 level 3" with different κ_b read the same), nor did its problem-case lines.
+TEST(TransitionGroups, StatusNamesTheKeyThatTellsTheGroupsApart) {
+  const std::string dir = fresh_dir("transition_groups_status");
+  const std::string db = dir + "/study.db";
+  write_file(dir + "/g.toml", prolate_campaign("kb-status", "bending_modulus = [0.0, 1e-3]\n"));
+  auto r = sh(campaign_cmd("FAKE_STEPS=1 FAKE_STEP_S=0.001 FAKE_FAIL_CA=0.4", dir + "/g.toml", db, "--jobs 2"));
+  ASSERT_EQ(r.code, 1) << r.err;  // finished, with the two Ca = 0.4 cases failed
+  const auto st = sh(exe() + " campaign status --db " + db);
+  ASSERT_EQ(st.code, 0) << st.err;
+  EXPECT_NE(st.out.find("| group |"), std::string::npos) << st.out;
+  EXPECT_NE(st.out.find("| capsule.bending_modulus=0.0 |"), std::string::npos) << st.out;
+  EXPECT_NE(st.out.find("| capsule.bending_modulus=0.001 |"), std::string::npos) << st.out;
+  EXPECT_NE(st.out.find("Ca=0.4 level 1 capsule.bending_modulus=0.001"), std::string::npos) << st.out;
+  // One group only: no such column (the table of a plain campaign is unchanged).
+  write_file(dir + "/h.toml", prolate_campaign("plain"));
+  ASSERT_EQ(sh(campaign_cmd("FAKE_STEPS=1 FAKE_STEP_S=0.001", dir + "/h.toml", dir + "/plain.db", "--jobs 2")).code, 0);
+  const auto plain = sh(exe() + " campaign status --db " + dir + "/plain.db");
+  EXPECT_EQ(plain.out.find("group"), std::string::npos) << plain.out;
+}
+
 }  // namespace
 }  // namespace capsim::campaign::testing

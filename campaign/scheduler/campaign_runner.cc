@@ -88,6 +88,7 @@ class Runner {
 
   /// Runs every queued case of the campaign; returns false if stopped by a signal.
   bool run_queued() {
+    learn_costs();
     auto rows = store_.campaign_cases(campaign_id_);
     std::vector<CaseRow> pending;
     for (auto& r : rows)
@@ -186,6 +187,16 @@ class Runner {
     running_.emplace(pid, std::move(r));
   }
 
+  /// The ETA learns from every finished case of the campaign, also those of earlier runs (a resumed
+  /// campaign has an ETA at once), with the worker's wall time over all attempts (the manager's own clock
+  /// sees only the last attempt of a resumed case). Cases run with other thread counts are scaled to this
+  /// run's as if the threads scaled perfectly: a first guess, which this run's own cases correct.
+  void learn_costs() {
+    eta_ = EtaModel{};
+    for (const auto& c : store_.finished_costs(campaign_id_))
+      eta_.add_done(c.mesh_level, c.est_cost, c.wall_s * std::max(1, c.threads) / std::max(1, threads_));
+  }
+
   void reap() {
     while (true) {
       int st = 0;
@@ -205,7 +216,7 @@ class Runner {
       const std::string status = store_.record_outcome(r.row.case_id, r.attempt_id, out, h5, r.row.params);
       if (status == "done" || status == "unstable") {
         ++finished_;
-        eta_.add_done(r.row.params.mesh_level(), r.row.est_cost, out.wall_s);
+        learn_costs();
       } else if (status == "failed") {
         ++failed_;
         progress_.message("capsim campaign: case " + r.row.case_id + " (Ca=" +
@@ -227,7 +238,7 @@ class Runner {
   std::map<pid_t, Running> running_;
   std::set<std::string> interrupted_;
   int total_ = 0, finished_ = 0, failed_ = 0, queued_ = 0;
-  EtaModel eta_;  // wall seconds per estimated cost, per mesh level, of the cases finished in this run
+  EtaModel eta_;  // per mesh level, wall seconds against estimated cost of the campaign's finished cases
 };
 
 /// After a manager crash: stop leftover workers, then ingest finished results or requeue.

@@ -20,36 +20,47 @@ std::string format_duration(double s) {
 }
 
 void EtaModel::add_done(int mesh_level, double est_cost, double wall_s) {
-  if (!(est_cost > 0) || !(wall_s >= 0)) return;
-  auto& [w, c] = by_level_[mesh_level];
-  w += wall_s;
-  c += est_cost;
-  wall_ += wall_s;
-  cost_ += est_cost;
+  if (!(est_cost > 0) || !(wall_s >= 0) || !std::isfinite(est_cost) || !std::isfinite(wall_s)) return;
+  const double x = std::log(est_cost), y = std::log(std::max(wall_s, 1e-3));
+  Sums& s = by_level_[mesh_level];
+  s.n += 1;
+  s.x += x;
+  s.y += y;
+  s.xx += x * x;
+  s.xy += x * y;
+  s.yy += y * y;
+}
+
+double EtaModel::predict_log(const Sums& s, double x) {
+  const double mx = s.x / s.n, my = s.y / s.n;
+  const double sxx = std::max(0.0, s.xx - s.n * mx * mx), sxy = s.xy - s.n * mx * my;
+  const double beta = std::clamp((sxy + kPriorWeight * kCostExponent) / (sxx + kPriorWeight), 0.0, 1.5);
+  // Residual variance of log wall about the law (unbiased once three cases are in); the prediction is the
+  // mean wall, not the median, because the ETA adds predictions up.
+  double var = 0;
+  if (s.n >= 3) {
+    const double syy = std::max(0.0, s.yy - s.n * my * my);
+    var = std::max(0.0, syy - 2 * beta * sxy + beta * beta * sxx) / (s.n - 2);
+  }
+  return my + beta * (x - mx) + 0.5 * std::min(var, 1.0);
 }
 
 double EtaModel::expected_s(int mesh_level, double est_cost) const {
-  if (!(cost_ > 0)) return -1;
-  const auto it = by_level_.find(mesh_level);
-  if (it != by_level_.end() && it->second.second > 0) return est_cost * it->second.first / it->second.second;
-  // No case of this level finished yet: the nearest level that has one (the coarser on a tie), corrected from
-  // the estimate's 32x per level to what whole cases measure per level.
-  int nearest = 0;
-  double ratio = -1;
-  for (const auto& [level, wc] : by_level_) {
-    if (!(wc.second > 0)) continue;
-    if (ratio < 0 || std::abs(level - mesh_level) < std::abs(nearest - mesh_level)) {
-      nearest = level;
-      ratio = wc.first / wc.second;
-    }
-  }
-  if (ratio < 0) ratio = wall_ / cost_;
-  return est_cost * ratio * std::pow(kMeasuredPerLevel / 32.0, mesh_level - nearest);
+  if (by_level_.empty() || !(est_cost > 0)) return -1;
+  const double x = std::log(est_cost);
+  if (const auto it = by_level_.find(mesh_level); it != by_level_.end()) return std::exp(predict_log(it->second, x));
+  // No case of this level finished yet: the nearest level that has one (the coarser on a tie), at the
+  // estimate moved to that level, times the measured factor per level.
+  int nearest = by_level_.begin()->first;
+  for (const auto& [level, _] : by_level_)
+    if (std::abs(level - mesh_level) < std::abs(nearest - mesh_level)) nearest = level;
+  const int d = mesh_level - nearest;
+  return std::exp(predict_log(by_level_.at(nearest), x - d * std::log(32.0))) * std::pow(kMeasuredPerLevel, d);
 }
 
 double EtaModel::remaining_s(const std::vector<std::pair<int, double>>& pending,
                              const std::vector<std::tuple<int, double, double>>& running, int jobs) const {
-  if (!(cost_ > 0)) return -1;
+  if (by_level_.empty()) return -1;
   double total = 0, longest = 0;
   bool overdue = false;
   for (const auto& [level, est] : pending) {

@@ -45,11 +45,21 @@ class Progress {
 
 /// @brief The time a campaign still needs, from what its finished cases cost.
 ///
-/// CaseParams::estimated_cost is a rough power law in the mesh level (32× per level, where whole cases measure
-/// 5–13×), so one ratio of measured wall time to estimated cost, taken over cheap cases that ran first
-/// (`--order shortest`, or a level-2 scan before level 3), misjudges the expensive rest by an order of
-/// magnitude. Each mesh level therefore keeps its own ratio; a level with no finished case yet borrows the
-/// ratio of the nearest level that has one, times (kMeasuredPerLevel / 32) per level between them.
+/// CaseParams::estimated_cost is a rough power law: 32× per mesh level, ∝ t_end / Ca. Whole cases measure
+/// neither: ≈ 9× per level, and within one level wall ∝ est_cost^0.2–0.33, not ∝ est_cost (the stage count
+/// grows like Ca^-1/2 only where the step is stability-limited, and periodic cases stop early). One ratio of
+/// wall time to estimated cost, taken over the cheap cases that ran first (`--order shortest`, or a level-2
+/// scan before level 3), misjudged the expensive rest by an order of magnitude (a certified Table 1 read
+/// ETA 134 h for about 25 h of work). So each mesh level fits its own power law
+///
+///     log wall = log wall_mean + β (log est − log est_mean),
+///
+/// by least squares over its finished cases, with β drawn towards kCostExponent (the fit of the committed
+/// databases) as if kPriorWeight cases spread one e-fold in est_cost had measured it: one case, or cases of
+/// one estimate, give β = kCostExponent; a hundred spread cases give their own β. The prediction is the
+/// arithmetic mean (× exp(s²/2), s² the residual variance in log wall), since the ETA sums predictions. A
+/// level with no finished case yet uses the nearest level that has one (the coarser on a tie): its law at
+/// the estimate moved to that level (÷ 32 per level), times kMeasuredPerLevel per level.
 class EtaModel {
  public:
   /// @brief What a whole case costs per mesh level finer, as measured: the geometric mean of the wall-time
@@ -57,7 +67,14 @@ class EtaModel {
   /// level-2/3 pairs, 9.5 over 5 level-3/4 pairs; single pairs range 1.1-24). Only an ETA's first guess for
   /// a level that has no finished case yet.
   static constexpr double kMeasuredPerLevel = 9.0;
-  /// @brief Records a finished case: its level, estimated cost and measured wall seconds.
+  /// @brief The exponent β of wall ∝ est_cost^β within one level, as measured (2026-12-03, least squares in
+  /// log-log): 0.28 over the 106 level-3 cases of table1.sqlite, 0.33 / 0.30 over 46 level-2 / 58 level-3
+  /// cases of table1_certified.sqlite, 0.19 / 0.24 over 112 / 101 of bending/table1_bending.sqlite.
+  static constexpr double kCostExponent = 0.3;
+  /// @brief How strongly β is drawn to kCostExponent: the Σ (log est − mean)² of a prior of that weight.
+  static constexpr double kPriorWeight = 4.0;
+  /// @brief Records a finished case: its level, estimated cost and measured wall seconds (of the whole
+  /// case, all attempts).
   void add_done(int mesh_level, double est_cost, double wall_s);
   /// @brief Expected wall seconds of a case of @p mesh_level with @p est_cost; < 0 before any case finished.
   [[nodiscard]] double expected_s(int mesh_level, double est_cost) const;
@@ -69,8 +86,13 @@ class EtaModel {
                                    const std::vector<std::tuple<int, double, double>>& running, int jobs) const;
 
  private:
-  std::map<int, std::pair<double, double>> by_level_;  // level -> (wall seconds, estimated cost)
-  double wall_ = 0, cost_ = 0;
+  /// Least-squares sums of one level, in logs: n, Σx, Σy, Σx², Σxy, Σy² (x = log est, y = log wall).
+  struct Sums {
+    double n = 0, x = 0, y = 0, xx = 0, xy = 0, yy = 0;
+  };
+  /// log wall predicted at log est @p x by the law of @p s.
+  static double predict_log(const Sums& s, double x);
+  std::map<int, Sums> by_level_;
 };
 
 /// @brief "1h02m", "3m20s", "12s".

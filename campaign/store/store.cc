@@ -665,6 +665,19 @@ int Store::count_campaign_cases(std::int64_t campaign_id, const std::string& ori
   return static_cast<int>(s.integer(0));
 }
 
+std::vector<Store::FinishedCost> Store::finished_costs(std::int64_t campaign_id) {
+  Stmt s(*db_,
+         "SELECT c.mesh_level, c.est_cost, r.wall_s, coalesce(json_extract(r.raw_json, '$.threads'), 1) "
+         "FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id JOIN results r ON r.case_id=c.case_id "
+         "WHERE cc.campaign_id=? AND c.status IN ('done', 'unstable') AND r.wall_s > 0");
+  s.bind(1, campaign_id);
+  std::vector<FinishedCost> out;
+  while (s.step())
+    out.push_back({static_cast<int>(s.integer(0)), s.real(1).value_or(1.0), s.real(2).value_or(0.0),
+                   static_cast<int>(s.integer(3))});
+  return out;
+}
+
 std::vector<Store::LevelCost> Store::level_costs(std::int64_t campaign_id) {
   Stmt s(*db_,
          "SELECT c.mesh_level, count(*), count(r.case_id), "

@@ -170,6 +170,16 @@ class Store {
   };
   std::vector<LevelCost> level_costs(std::int64_t campaign_id);
 
+  /// @brief What one finished case of a campaign cost (the ETA's evidence).
+  struct FinishedCost {
+    int mesh_level = 0;
+    double est_cost = 1;  ///< CaseParams::estimated_cost as stored
+    double wall_s = 0;    ///< the worker's wall seconds over all attempts (results.wall_s)
+    int threads = 1;      ///< threads it ran with
+  };
+  /// @brief The done or unstable cases of @p campaign_id with a recorded wall time.
+  std::vector<FinishedCost> finished_costs(std::int64_t campaign_id);
+
  private:
   explicit Store(std::unique_ptr<Db> db) : db_(std::move(db)) {}
   std::unique_ptr<Db> db_;

@@ -1,10 +1,12 @@
 // One membrane load evaluation (solver/README.md §2) split into its phases, at levels 3 and 4:
 // kinematics + energy gradient R, mass-matrix assembly, CHOLMOD numeric factorisation (symbolic analysis is
-// cached), triangular solves; and the conjugate-gradient alternative for the same M q = R.
+// cached), triangular solves; and the conjugate-gradient alternative for the same M q = R; and the bending
+// evaluation.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
 
+#include "solver/membrane/bending.h"
 #include "solver/membrane/load_solver.h"
 #include "solver/membrane/membrane_mechanics.h"
 
@@ -86,6 +88,22 @@ void BM_WholeLoadEvaluation(benchmark::State& state) {
   }
 }
 
+// Bending (solver/membrane/bending.h), κ_b = 1e-3; second argument 0: the whole evaluation (K x, assembly,
+// the curvature solve, the point loops, the adjoint solve), 1: its first phase alone (K x, assembly, the
+// curvature solve, c at the points).
+void BM_Bending(benchmark::State& state) {
+  Problem p(static_cast<int>(state.range(0)));
+  membrane::LoadSolver::Options o;
+  membrane::BendingMechanics bending(p.mesh, p.mesh.nodes, membrane::HelfrichBending(1e-3), o);
+  membrane::LoadSolver solver(p.mesh, o);
+  const bool curvature_only = state.range(1) == 1;
+  for (auto _ : state) {
+    if (curvature_only) benchmark::DoNotOptimize(bending.total_curvature(p.x, solver));
+    else benchmark::DoNotOptimize(bending.evaluate(p.x, solver));
+  }
+}
+
+BENCHMARK(BM_Bending)->Args({3, 0})->Args({3, 1})->Args({4, 0})->Args({4, 1})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_InternalForces)->Arg(3)->Arg(4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MassAssembly)->Arg(3)->Arg(4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CholmodFactorize)->Arg(3)->Arg(4)->Unit(benchmark::kMillisecond);

@@ -17,6 +17,7 @@
 #include "campaign/grid/precision.h"
 #include "campaign/query/table_output.h"
 #include "campaign/scheduler/campaign_runner.h"
+#include "campaign/scheduler/progress.h"
 #include "campaign/slurm/slurm.h"
 #include "campaign/store/store.h"
 #include "solver/config/case_keys.h"
@@ -145,6 +146,17 @@ int status(const std::string& db_path, const std::string& name) {
         std::printf(" level %d: %d cases (%d finished, %s core-h);", l.mesh_level, l.cases, l.finished,
                     campaign::format_significant(l.core_s / 3600.0, 3).c_str());
       std::printf("\n");
+    }
+    // The work still to do, as the runner's ETA would see it (one thread per case).
+    {
+      std::vector<std::pair<int, double>> left;
+      for (const auto& r : store->campaign_cases(c.campaign_id))
+        if (r.status == "queued" || r.status == "running") left.emplace_back(r.params.mesh_level(), r.est_cost);
+      const double s = left.empty() ? -1 : campaign::learn_eta(*store, c.campaign_id, 1).remaining_s(left, {}, 1);
+      if (s > 0)
+        std::printf("  work left: about %s core-h in the %zu queued and running cases (from what its finished cases "
+                    "cost, per mesh level; running cases counted whole; good to a factor of about two)\n",
+                    campaign::format_significant(s / 3600.0, 2).c_str(), left.size());
     }
     if (!tr.empty()) std::printf("%s", campaign::render(transitions_table(tr), campaign::Format::kMarkdown).c_str());
     campaign::print_slurm_status(store->db(), c.campaign_id);

@@ -187,15 +187,8 @@ class Runner {
     running_.emplace(pid, std::move(r));
   }
 
-  /// The ETA learns from every finished case of the campaign, also those of earlier runs (a resumed
-  /// campaign has an ETA at once), with the worker's wall time over all attempts (the manager's own clock
-  /// sees only the last attempt of a resumed case). Cases run with other thread counts are scaled to this
-  /// run's as if the threads scaled perfectly: a first guess, which this run's own cases correct.
-  void learn_costs() {
-    eta_ = EtaModel{};
-    for (const auto& c : store_.finished_costs(campaign_id_))
-      eta_.add_done(c.mesh_level, c.est_cost, c.wall_s * std::max(1, c.threads) / std::max(1, threads_));
-  }
+  // The ETA learns from every finished case of the campaign (learn_eta), earlier runs included.
+  void learn_costs() { eta_ = learn_eta(store_, campaign_id_, threads_); }
 
   void reap() {
     while (true) {

@@ -80,6 +80,13 @@ double EtaModel::remaining_s(const std::vector<std::pair<int, double>>& pending,
   return std::max(total / std::max(1, jobs), longest);
 }
 
+EtaModel learn_eta(Store& store, std::int64_t campaign_id, int threads) {
+  EtaModel m;
+  for (const auto& c : store.finished_costs(campaign_id))
+    m.add_done(c.mesh_level, c.est_cost, c.wall_s * std::max(1, c.threads) / std::max(1, threads));
+  return m;
+}
+
 Progress::Progress(std::string name) : name_(std::move(name)), tty_(isatty(STDERR_FILENO) == 1) {}
 
 std::string Progress::format(const ProgressCounts& c) const {

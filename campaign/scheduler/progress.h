@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "campaign/store/store.h"
+
 namespace capsim::campaign {
 
 /// @brief Counts shown by the progress display.
@@ -94,6 +96,12 @@ class EtaModel {
   static double predict_log(const Sums& s, double x);
   std::map<int, Sums> by_level_;
 };
+
+/// @brief An EtaModel learnt from every finished case of @p campaign_id (also of earlier runs), with the
+/// worker's wall time over all attempts (a manager's own clock sees only the last attempt of a resumed case);
+/// cases run with another thread count are scaled to @p threads as if threads scaled perfectly (a first
+/// guess, which cases run with @p threads correct).
+EtaModel learn_eta(Store& store, std::int64_t campaign_id, int threads);
 
 /// @brief "1h02m", "3m20s", "12s".
 std::string format_duration(double seconds);

@@ -299,6 +299,13 @@ TEST_F(ScriptsTest, MeshCheckComparesRunsOverOneWindow) {
     const Cmd b = sh(mesh_check() + bad + " --period 1");
     EXPECT_EQ(b.code, 2) << bad << "\n" << b.err;
   }
+  // --plot draws the series into a PNG; an unwritable path is bad input.
+  const auto png = dir_ / "mesh_check.png";
+  const Cmd p = sh(mesh_check() + " A=" + q(h5) + " B=" + q(h5) + " --period 1 --t1 2.5 --plot " + q(png));
+  ASSERT_EQ(p.code, 0) << p.err;
+  EXPECT_TRUE(is_png(png));
+  const Cmd unwritable = sh(mesh_check() + " A=" + q(h5) + " --period 1 --plot " + q(dir_ / "no-such-dir" / "x.png"));
+  EXPECT_EQ(unwritable.code, 2) << unwritable.err;
 }
 
 TEST(SeedTable1, HoldsTheSeedValues) {

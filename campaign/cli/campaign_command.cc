@@ -21,6 +21,7 @@
 #include "campaign/slurm/slurm.h"
 #include "campaign/store/store.h"
 #include "solver/config/case_keys.h"
+#include "solver/io/checkpoint.h"
 
 namespace capsim::cli {
 
@@ -114,6 +115,25 @@ int analyse(const std::string& db_path, const std::string& name) {
   return 0;
 }
 
+// How far a running or interrupted case has got, from its last checkpoint in its folder (the worker writes one
+// every output.checkpoint_interval and on interrupt): " (checkpoint at γ̇t = 20 of 40)", or "".
+std::string checkpoint_progress(const campaign::ProblemCase& p) {
+  if (p.status != "running" && p.status != "queued") return "";
+  if (p.out_dir.empty()) return "";
+  const std::filesystem::path file = std::filesystem::path(p.out_dir) / "checkpoint.h5";
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) return "";
+  try {
+    const io::Checkpoint cp = io::read_checkpoint(file);
+    char buf[96];
+    std::snprintf(buf, sizeof buf, " (checkpoint at γ̇t = %.4g of %.4g)", cp.time, p.t_end);
+    return buf;
+  } catch (const std::exception&) {
+    return " (checkpoint unreadable: resuming will fail with exit 2; remove " + file.string() +
+           " to start the case afresh)";
+  }
+}
+
 int status(const std::string& db_path, const std::string& name) {
   auto store = campaign::Store::open_readonly(db_path);
   const auto camps = store->campaigns(name);
@@ -132,12 +152,12 @@ int status(const std::string& db_path, const std::string& name) {
     for (const auto& p : problems) groups.push_back(p.group_key);
     const auto keys = varying_keys(groups);
     for (const auto& p : problems) {
-      std::string err = p.error;
+      std::string err = p.status == "running" ? "" : p.error;  // a running case's error is its last attempt's
       if (err.size() > 160) err = err.substr(0, 157) + "...";
       const std::string more = keys.empty() ? "" : " " + key_values(p.group_key, keys);
-      std::printf("  %-8s %s  %s a/b=%s Ca=%s level %d%s  %s\n", p.status.c_str(), p.case_id.c_str(), p.law.c_str(),
+      std::printf("  %-8s %s  %s a/b=%s Ca=%s level %d%s  %s%s\n", p.status.c_str(), p.case_id.c_str(), p.law.c_str(),
                   campaign::canonical_double(p.aspect_ratio).c_str(), campaign::canonical_double(p.capillary_number).c_str(),
-                  p.mesh_level, more.c_str(), err.c_str());
+                  p.mesh_level, more.c_str(), err.c_str(), checkpoint_progress(p).c_str());
     }
     // What each mesh level cost (a multi-fidelity campaign's saving is read here).
     if (const auto costs = store->level_costs(c.campaign_id); costs.size() > 1) {

@@ -622,7 +622,8 @@ StatusCounts Store::status_counts(std::int64_t campaign_id) {
 
 std::vector<ProblemCase> Store::problem_cases(std::int64_t campaign_id, int limit) {
   Stmt s(*db_, "SELECT c.case_id, c.law, c.aspect_ratio, c.capillary_number, c.status, "
-               "coalesce(c.error,''), c.mesh_level, c.params_json FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id "
+               "coalesce(c.error,''), c.mesh_level, c.params_json, coalesce(c.out_dir,'') FROM cases c JOIN campaign_cases cc "
+               "ON cc.case_id=c.case_id "
                "WHERE cc.campaign_id=? AND (c.status IN ('failed','unstable','running') OR "
                "(c.status='queued' AND c.attempts>0)) ORDER BY c.status, c.law, c.aspect_ratio, "
                "c.capillary_number LIMIT ?");
@@ -637,7 +638,10 @@ std::vector<ProblemCase> Store::problem_cases(std::int64_t campaign_id, int limi
     p.status = s.text(4);
     p.error = s.text(5);
     p.mesh_level = static_cast<int>(s.integer(6));
-    p.group_key = group_key(CaseParams::from_json(s.text(7)));
+    const CaseParams params = CaseParams::from_json(s.text(7));
+    p.group_key = group_key(params);
+    p.out_dir = s.text(8);
+    p.t_end = params.t_end();
     out.push_back(std::move(p));
   }
   return out;

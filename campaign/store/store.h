@@ -72,6 +72,8 @@ struct ProblemCase {
   double aspect_ratio = 0, capillary_number = 0;  ///< a/b, Ca
   int mesh_level = 0;                       ///< mesh level
   std::string group_key;                    ///< its transition group (analysis/transitions.h group_key)
+  std::string out_dir;                      ///< its case folder ("" before its first start)
+  double t_end = 0;                         ///< time.t_end of the case
 };
 
 /// @brief Filters of `capsim query cases` (empty / non-positive: no filter).

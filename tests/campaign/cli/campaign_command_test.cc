@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
+#include <filesystem>
+
 #include "tests/campaign/test_util.h"
 
 namespace capsim::campaign::testing {
@@ -31,6 +33,39 @@ TEST(CampaignStatus, SaysHowMuchWorkIsLeftOnlyWhileCasesAreLeft) {
   const double core_h = std::stod(left.out.substr(at + 17));
   EXPECT_GT(core_h, 0.1 / 3600);
   EXPECT_LT(core_h, 1.0 / 3600);
+}
+
+// A case interrupted with a checkpoint says how far it got (from the checkpoint in its folder), so a scientist
+// can see what an hours-long level-4 case has done without opening its log.
+TEST(CampaignStatus, AnInterruptedCaseSaysHowFarItsCheckpointGot) {
+  const std::string dir = fresh_dir("campaign_status_checkpoint");
+  const std::string db = dir + "/study.db";
+  write_file(dir + "/c.toml", prolate_campaign("cp"));
+  ASSERT_EQ(sh(campaign_cmd("FAKE_STEPS=1 FAKE_STEP_S=0.001", dir + "/c.toml", db, "--jobs 2")).code, 0);
+  // A real checkpoint: the solver stopped after 5 steps of dt = 0.02 (t = 0.1).
+  const auto run = sh(exe() + " run - --set mesh.level=1 --set time.dt=0.02 --stop-after 5 --threads 1 --quiet --out " +
+                      dir + "/real");
+  ASSERT_EQ(run.code, 3) << run.err;
+  sqlite3* h = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &h), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(h, "UPDATE cases SET status='queued', resumable=1, attempts=1, "
+                            "error='interrupted (checkpoint written; resumes with --resume)' WHERE case_id IN "
+                            "(SELECT case_id FROM cases ORDER BY case_id LIMIT 1)", nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(h);
+  std::string folder = sql(db, "SELECT out_dir FROM cases ORDER BY case_id LIMIT 1");
+  while (!folder.empty() && (folder.back() == '\n' || folder.back() == '\r')) folder.pop_back();
+  ASSERT_FALSE(folder.empty());
+  std::filesystem::copy_file(dir + "/real/checkpoint.h5", folder + "/checkpoint.h5",
+                             std::filesystem::copy_options::overwrite_existing);
+  const auto st = sh(exe() + " campaign status --db " + db);
+  ASSERT_EQ(st.code, 0) << st.err;
+  EXPECT_NE(st.out.find("(checkpoint at γ̇t = 0.1 of "), std::string::npos) << st.out;
+  // A corrupt checkpoint is said to be one (a resumed worker refuses it with exit 2), not a crash.
+  write_file(folder + "/checkpoint.h5", "not HDF5");
+  const auto bad = sh(exe() + " campaign status --db " + db);
+  ASSERT_EQ(bad.code, 0) << bad.err;
+  EXPECT_NE(bad.out.find("(checkpoint unreadable: resuming will fail"), std::string::npos) << bad.out;
 }
 
 }  // namespace

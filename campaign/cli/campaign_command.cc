@@ -155,9 +155,11 @@ int status(const std::string& db_path, const std::string& name) {
       std::string err = p.status == "running" ? "" : p.error;  // a running case's error is its last attempt's
       if (err.size() > 160) err = err.substr(0, 157) + "...";
       const std::string more = keys.empty() ? "" : " " + key_values(p.group_key, keys);
-      std::printf("  %-8s %s  %s a/b=%s Ca=%s level %d%s  %s%s\n", p.status.c_str(), p.case_id.c_str(), p.law.c_str(),
+      std::string note = err + checkpoint_progress(p);
+      if (err.empty() && !note.empty()) note.erase(0, 1);  // the progress alone: no leading blank
+      std::printf("  %-8s %s  %s a/b=%s Ca=%s level %d%s  %s\n", p.status.c_str(), p.case_id.c_str(), p.law.c_str(),
                   campaign::canonical_double(p.aspect_ratio).c_str(), campaign::canonical_double(p.capillary_number).c_str(),
-                  p.mesh_level, more.c_str(), err.c_str(), checkpoint_progress(p).c_str());
+                  p.mesh_level, more.c_str(), note.c_str());
     }
     // What each mesh level cost (a multi-fidelity campaign's saving is read here).
     if (const auto costs = store->level_costs(c.campaign_id); costs.size() > 1) {

@@ -120,7 +120,7 @@ int analyse(const std::string& db_path, const std::string& name) {
 std::string checkpoint_progress(const campaign::ProblemCase& p) {
   if (p.status != "running" && p.status != "queued") return "";
   if (p.out_dir.empty()) return "";
-  const std::filesystem::path file = std::filesystem::path(p.out_dir) / "checkpoint.h5";
+  const std::filesystem::path file = std::filesystem::path(p.out_dir) / io::kCheckpointFileName;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) return "";
   try {

@@ -1,5 +1,7 @@
 #include "campaign/scheduler/progress.h"
 
+#include "campaign/store/store.h"
+
 #include <cmath>
 
 #include <unistd.h>

@@ -3,15 +3,16 @@
 /// @brief The campaign progress display on stderr: a redrawn line on a terminal, a plain log otherwise.
 
 #include <chrono>
+#include <cstdint>
 #include <map>
 #include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
 
-#include "campaign/store/store.h"
-
 namespace capsim::campaign {
+
+class Store;
 
 /// @brief Counts shown by the progress display.
 struct ProgressCounts {

@@ -87,7 +87,7 @@ class CaseRun {
     std::filesystem::create_directories(options_.out_dir, ec);
     if (ec) throw io::IoError(options_.out_dir, "cannot create the output folder: " + ec.message());
     case_file_ = options_.out_dir / "case.h5";
-    checkpoint_file_ = options_.out_dir / "checkpoint.h5";
+    checkpoint_file_ = options_.out_dir / io::kCheckpointFileName;
     flow_.emplace(config_);
     dt_ = config_.dt ? *config_.dt : dynamics::automatic_time_step(config_, mesh());
     V0_ = membrane::area_and_volume(mesh(), flow_->reference()).volume;

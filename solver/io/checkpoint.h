@@ -25,6 +25,9 @@
 
 namespace capsim::io {
 
+/// @brief The checkpoint's file name in a case's output folder (`capsim run --out DIR`): DIR/checkpoint.h5.
+inline constexpr const char* kCheckpointFileName = "checkpoint.h5";
+
 /// @brief Format version of the checkpoints written by this build.
 inline constexpr std::int64_t kCheckpointFormatVersion = 1;
 

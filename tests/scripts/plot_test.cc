@@ -160,6 +160,35 @@ TEST_F(ScriptsTest, PlotsTheBendingFigureFromABendingCampaign) {
   EXPECT_NE(none.err.find("no finished case with a bending modulus"), std::string::npos) << none.err;
 }
 
+// Figure 6 (Table 1 against κ_b) from `capsim query table1 --format json` files, one per campaign: drawn when
+// a row has κ_b > 0, a cell without a bracketed CaH named in a note; without any κ_b > 0 nothing to draw
+// (exit 1), a corrupt file one message and exit 2.
+TEST_F(ScriptsTest, PlotsTable1AgainstTheBendingModulus) {
+  const auto kb0 = dir_ / "table1_kb0.json";
+  const auto kb2 = dir_ / "table1_kb1e-2.json";
+  std::ofstream(kb0) << R"([{"law": "neo-hookean", "aspect_ratio": 0.5, "ca_star_low": 0.025, "ca_star_high": 0.05,
+      "ca_h": 0.6, "ca_star_low_err": 0.01, "ca_star_high_err": 0.008, "ca_h_err": 0.4, "bending_modulus": 0.0},
+      {"law": "skalak", "aspect_ratio": 1.0, "ca_h": 2.46, "ca_h_err": 0.04}])";
+  std::ofstream(kb2) << R"([{"law": "neo-hookean", "aspect_ratio": 0.5, "ca_star_low": 0.15, "ca_star_high": 0.2,
+      "ca_h": 0.67, "ca_h_err": 0.13, "bending_modulus": 0.01},
+      {"law": "skalak", "aspect_ratio": 1.0, "ca_h": null, "bending_modulus": 0.01}])";
+  const auto out = dir_ / "fig6";
+  fs::remove_all(out);
+  const Cmd r = sh(plot() + " --table1 " + q(kb0) + " --table1 " + q(kb2) + " --only 6 --out " + q(out));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(is_png(out / "bending_figure6.png"));
+  EXPECT_NE(r.err.find("Sk a/b 1 κ_b 0.01: CaH not bracketed"), std::string::npos) << r.err;
+  const Cmd zero = sh(plot() + " --table1 " + q(kb0) + " --only 6 --out " + q(dir_ / "fig6_none"));
+  EXPECT_EQ(zero.code, 1) << zero.err;
+  EXPECT_NE(zero.err.find("no --table1 row has a bending modulus > 0"), std::string::npos) << zero.err;
+  const auto junk = dir_ / "junk_table1.json";
+  std::ofstream(junk) << "{not json";
+  const Cmd bad = sh(plot() + " --table1 " + q(junk) + " --only 6 --out " + q(out));
+  EXPECT_EQ(bad.code, 2) << bad.err;
+  EXPECT_EQ(count_lines(bad.err), 1) << bad.err;
+  EXPECT_NE(bad.err.find("junk_table1.json"), std::string::npos) << bad.err;
+}
+
 TEST_F(ScriptsTest, Table1FromTheDatabaseComparesCellByCell) {
   const auto md = dir_ / "table1.md";
   fs::remove(md);

@@ -18,6 +18,7 @@
 #include "campaign/query/table_output.h"
 #include "campaign/scheduler/campaign_runner.h"
 #include "campaign/scheduler/progress.h"
+#include "campaign/scheduler/worker_process.h"
 #include "campaign/slurm/slurm.h"
 #include "campaign/store/store.h"
 #include "solver/config/case_keys.h"
@@ -171,13 +172,15 @@ int status(const std::string& db_path, const std::string& name) {
     }
     // The work still to do, as the runner's ETA would see it (one thread per case).
     {
-      std::vector<std::pair<int, double>> left;
+      // A case with a checkpoint counts the part after it (a running case's is where it has got to).
+      std::vector<campaign::EtaModel::Work> left;
       for (const auto& r : store->campaign_cases(c.campaign_id))
-        if (r.status == "queued" || r.status == "running") left.emplace_back(r.params.mesh_level(), r.est_cost);
-      const double s = left.empty() ? -1 : campaign::learn_eta(*store, c.campaign_id, 1).remaining_s(left, {}, 1);
+        if (r.status == "queued" || r.status == "running")
+          left.push_back({r.params.mesh_level(), r.est_cost, campaign::work_fraction_left(r.out_dir, r.params.t_end())});
+      const double s = left.empty() ? -1 : campaign::learn_eta(*store, c.campaign_id, 1).remaining_s(left, 1);
       if (s > 0)
         std::printf("  work left: about %s core-h in the %zu queued and running cases (from what its finished cases "
-                    "cost, per mesh level; running cases counted whole; good to a factor of about two)\n",
+                    "cost, per mesh level, after their checkpoints; good to a factor of about two)\n",
                     campaign::format_significant(s / 3600.0, 2).c_str(), left.size());
     }
     if (!tr.empty()) std::printf("%s", campaign::render(transitions_table(tr), campaign::Format::kMarkdown).c_str());

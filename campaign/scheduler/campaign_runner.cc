@@ -76,6 +76,7 @@ struct Running {
   CaseRow row;
   std::int64_t attempt_id = 0;
   std::chrono::steady_clock::time_point start;
+  double fraction_left = 1;  ///< of the whole case, when this attempt started (a resumed case has run part)
 };
 
 class Runner {
@@ -151,14 +152,15 @@ class Runner {
     c.failed = failed_;
     c.running = static_cast<int>(running_.size());
     c.queued = queued_;
-    std::vector<std::pair<int, double>> todo;
-    todo.reserve(pending.size());
-    for (const auto& r : pending) todo.emplace_back(r.params.mesh_level(), r.est_cost);
-    std::vector<std::tuple<int, double, double>> busy;
+    std::vector<EtaModel::Work> work;
+    work.reserve(pending.size() + running_.size());
+    // A queued resumable case is counted whole: reading its checkpoint at every redraw is not worth it.
+    for (const auto& r : pending) work.push_back({r.params.mesh_level(), r.est_cost, 1.0, false, 0.0});
     const auto now = std::chrono::steady_clock::now();
     for (const auto& [_, r] : running_)
-      busy.emplace_back(r.row.params.mesh_level(), r.row.est_cost, std::chrono::duration<double>(now - r.start).count());
-    c.eta_s = eta_.remaining_s(todo, busy, jobs_);
+      work.push_back({r.row.params.mesh_level(), r.row.est_cost, r.fraction_left, true,
+                      std::chrono::duration<double>(now - r.start).count()});
+    c.eta_s = eta_.remaining_s(work, jobs_);
     return c;
   }
 
@@ -181,6 +183,7 @@ class Runner {
     }
     pid_t pid = spawn_worker(cmd);
     Running r;
+    r.fraction_left = resume ? work_fraction_left(row.out_dir, row.params.t_end()) : 1.0;
     r.attempt_id = store_.mark_running(row.case_id, host_, pid, resume);
     r.row = std::move(row);
     r.start = std::chrono::steady_clock::now();

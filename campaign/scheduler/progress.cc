@@ -60,19 +60,14 @@ double EtaModel::expected_s(int mesh_level, double est_cost) const {
   return std::exp(predict_log(by_level_.at(nearest), x - d * std::log(32.0))) * std::pow(kMeasuredPerLevel, d);
 }
 
-double EtaModel::remaining_s(const std::vector<std::pair<int, double>>& pending,
-                             const std::vector<std::tuple<int, double, double>>& running, int jobs) const {
+double EtaModel::remaining_s(const std::vector<Work>& cases, int jobs) const {
   if (by_level_.empty()) return -1;
   double total = 0, longest = 0;
   bool overdue = false;
-  for (const auto& [level, est] : pending) {
-    const double e = expected_s(level, est);
-    total += e;
-    longest = std::max(longest, e);
-  }
-  for (const auto& [level, est, elapsed] : running) {
-    const double e = expected_s(level, est) - elapsed;
-    overdue |= e <= 0;
+  for (const auto& w : cases) {
+    const double e = expected_s(w.mesh_level, w.est_cost) * std::clamp(w.fraction_left, 0.0, 1.0) -
+                     (w.running ? w.elapsed_s : 0.0);
+    overdue |= w.running && e <= 0;
     total += std::max(0.0, e);
     longest = std::max(longest, e);
   }

@@ -6,8 +6,6 @@
 #include <cstdint>
 #include <map>
 #include <string>
-#include <tuple>
-#include <utility>
 #include <vector>
 
 namespace capsim::campaign {
@@ -81,12 +79,22 @@ class EtaModel {
   void add_done(int mesh_level, double est_cost, double wall_s);
   /// @brief Expected wall seconds of a case of @p mesh_level with @p est_cost; < 0 before any case finished.
   [[nodiscard]] double expected_s(int mesh_level, double est_cost) const;
-  /// @brief Seconds until the last case ends: the work of @p pending (level, est_cost) and what @p running
-  /// (level, est_cost, elapsed seconds) still needs, spread over @p jobs workers, but never less than the
-  /// longest single remainder (one long case does not split). < 0 (printed "?") before any case finished,
-  /// and when all that is left is running cases that already ran past their estimate.
-  [[nodiscard]] double remaining_s(const std::vector<std::pair<int, double>>& pending,
-                                   const std::vector<std::tuple<int, double, double>>& running, int jobs) const;
+  /// @brief One case still to run or running, as the ETA sees it.
+  struct Work {
+    int mesh_level = 0;
+    double est_cost = 1;
+    /// Part of the whole case still to run when its current attempt started (or now, for a queued case):
+    /// 1 − t/t_end for a case resuming from a checkpoint at γ̇t = t, 1 for a fresh one. An upper bound: a case
+    /// whose periods converge stops before t_end.
+    double fraction_left = 1;
+    bool running = false;
+    double elapsed_s = 0;  ///< of the current attempt (running cases)
+  };
+  /// @brief Seconds until the last case ends: the predicted work of @p cases (whole-case prediction ×
+  /// fraction_left, minus what a running case has run of it), spread over @p jobs workers, but never less
+  /// than the longest single remainder (one long case does not split). < 0 (printed "?") before any case
+  /// finished, and when all that is left is running cases that already ran past their estimate.
+  [[nodiscard]] double remaining_s(const std::vector<Work>& cases, int jobs) const;
 
  private:
   /// Least-squares sums of one level, in logs: n, Σx, Σy, Σx², Σxy, Σy² (x = log est, y = log wall).

@@ -16,6 +16,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "solver/io/checkpoint.h"
+
 namespace capsim::campaign {
 
 namespace fs = std::filesystem;
@@ -168,6 +170,18 @@ bool has_checkpoint(const std::string& dir) {
       return true;
   }
   return false;
+}
+
+double work_fraction_left(const std::string& dir, double t_end) {
+  if (dir.empty() || !(t_end > 0)) return 1.0;
+  const fs::path file = fs::path(dir) / io::kCheckpointFileName;
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) return 1.0;
+  try {
+    return std::clamp(1.0 - io::read_checkpoint(file).time / t_end, 0.0, 1.0);
+  } catch (const std::exception&) {
+    return 1.0;  // unreadable: resuming fails and the case is started afresh (campaign status says so)
+  }
 }
 
 }  // namespace capsim::campaign

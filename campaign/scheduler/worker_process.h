@@ -46,4 +46,10 @@ std::string tail_of(const std::string& path, std::size_t max_chars);
 /// @brief True if a file whose name contains "checkpoint" exists in @p dir (a resumable case).
 bool has_checkpoint(const std::string& dir);
 
+/// @brief The part of a case still to run when it resumes from the checkpoint in its folder @p dir
+/// (io::kCheckpointFileName, read for its γ̇t = t): 1 − t / @p t_end, in [0, 1]; 1 when the folder has no
+/// readable checkpoint (the case starts afresh). For the ETA: an upper bound, since converged periods stop a
+/// case before t_end.
+double work_fraction_left(const std::string& dir, double t_end);
+
 }  // namespace capsim::campaign

@@ -40,7 +40,9 @@ TEST(CampaignStatus, SaysHowMuchWorkIsLeftOnlyWhileCasesAreLeft) {
 TEST(CampaignStatus, AnInterruptedCaseSaysHowFarItsCheckpointGot) {
   const std::string dir = fresh_dir("campaign_status_checkpoint");
   const std::string db = dir + "/study.db";
-  write_file(dir + "/c.toml", prolate_campaign("cp"));
+  // t_end = 0.4: the checkpoint at γ̇t = 0.1 below leaves three quarters of the case to run.
+  write_file(dir + "/c.toml", "[campaign]\nname = \"cp\"\n[defaults]\nmesh.level = 1\ntime.t_end = 0.4\n[[grid]]\n"
+                              "aspect_ratio = [2.0]\nlaw = [\"neo-hookean\"]\ncapillary_number = [0.1, 0.2, 0.3, 0.4]\n");
   ASSERT_EQ(sh(campaign_cmd("FAKE_STEPS=1 FAKE_STEP_S=0.001", dir + "/c.toml", db, "--jobs 2")).code, 0);
   // A real checkpoint: the solver stopped after 5 steps of dt = 0.02 (t = 0.1).
   const auto run = sh(exe() + " run - --set mesh.level=1 --set time.dt=0.02 --stop-after 5 --threads 1 --quiet --out " +
@@ -56,11 +58,20 @@ TEST(CampaignStatus, AnInterruptedCaseSaysHowFarItsCheckpointGot) {
   std::string folder = sql(db, "SELECT out_dir FROM cases ORDER BY case_id LIMIT 1");
   while (!folder.empty() && (folder.back() == '\n' || folder.back() == '\r')) folder.pop_back();
   ASSERT_FALSE(folder.empty());
+  const auto work_left = [](const std::string& out) {
+    const auto at = out.find("work left: about ");
+    return at == std::string::npos ? -1.0 : std::stod(out.substr(at + 17));
+  };
+  const auto whole = sh(exe() + " campaign status --db " + db);
+  ASSERT_EQ(whole.code, 0) << whole.err;
   std::filesystem::copy_file(dir + "/real/checkpoint.h5", folder + "/checkpoint.h5",
                              std::filesystem::copy_options::overwrite_existing);
   const auto st = sh(exe() + " campaign status --db " + db);
   ASSERT_EQ(st.code, 0) << st.err;
-  EXPECT_NE(st.out.find("(checkpoint at γ̇t = 0.1 of "), std::string::npos) << st.out;
+  EXPECT_NE(st.out.find("(checkpoint at γ̇t = 0.1 of 0.4)"), std::string::npos) << st.out;
+  // The work left is the part after the checkpoint (printed to two digits: ±2 %), not the whole case.
+  ASSERT_GT(work_left(whole.out), 0) << whole.out;
+  EXPECT_NEAR(work_left(st.out) / work_left(whole.out), 0.75, 0.03) << whole.out << st.out;
   // A corrupt checkpoint is said to be one (a resumed worker refuses it with exit 2), not a crash.
   write_file(folder + "/checkpoint.h5", "not HDF5");
   const auto bad = sh(exe() + " campaign status --db " + db);

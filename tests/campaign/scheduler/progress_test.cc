@@ -12,7 +12,7 @@ namespace {
 TEST(EtaModel, UnknownBeforeAnyCaseFinished) {
   EtaModel m;
   EXPECT_LT(m.expected_s(3, 10.0), 0);
-  EXPECT_LT(m.remaining_s({{3, 10.0}}, {}, 2), 0);
+  EXPECT_LT(m.remaining_s({{3, 10.0}}, 2), 0);
 }
 
 TEST(EtaModel, EachLevelKeepsItsOwnLaw) {
@@ -76,7 +76,7 @@ TEST(EtaModel, TheFirstCasesOfAFinerLevelAreExpectedAtTheMeasuredFactorPerLevel)
   EtaModel m;
   for (int i = 0; i < 8; ++i) m.add_done(2, 1.0, 60.0);  // eight level-2 cases of a minute each
   EXPECT_NEAR(m.expected_s(3, 32.0), 9.0 * 60.0, 1e-9);
-  EXPECT_NEAR(m.remaining_s(std::vector<std::pair<int, double>>(8, {3, 32.0}), {}, 1), 8 * 9.0 * 60.0, 1e-8);
+  EXPECT_NEAR(m.remaining_s(std::vector<EtaModel::Work>(8, {3, 32.0}), 1), 8 * 9.0 * 60.0, 1e-8);
 }
 
 TEST(EtaModel, RemainingCountsThePendingWorkNotTheMeanOfWhatFinished) {
@@ -85,15 +85,35 @@ TEST(EtaModel, RemainingCountsThePendingWorkNotTheMeanOfWhatFinished) {
   EtaModel m;
   for (int i = 0; i < 10; ++i) m.add_done(2, 1.0, 1.0);
   m.add_done(3, 100.0, 50.0);
-  EXPECT_NEAR(m.remaining_s({{3, 100.0}, {3, 100.0}}, {}, 2), 50.0, 1e-9);
+  EXPECT_NEAR(m.remaining_s({{3, 100.0}, {3, 100.0}}, 2), 50.0, 1e-9);
   // A running case counts what it still needs; one long case does not split between two workers.
   const double e400 = m.expected_s(3, 400.0);
   EXPECT_GT(e400, 50.0);
-  EXPECT_NEAR(m.remaining_s({}, {{3, 400.0, 20.0}}, 2), e400 - 20.0, 1e-9);
-  EXPECT_NEAR(m.remaining_s({{2, 1.0}}, {{3, 400.0, e400 + 10.0}}, 2), 1.0, 1e-9);
+  const auto running = [](double est, double elapsed, double left = 1.0) {
+    return EtaModel::Work{3, est, left, true, elapsed};
+  };
+  EXPECT_NEAR(m.remaining_s({running(400.0, 20.0)}, 2), e400 - 20.0, 1e-9);
+  EXPECT_NEAR(m.remaining_s({{2, 1.0}, running(400.0, e400 + 10.0)}, 2), 1.0, 1e-9);
   // Only a case past its estimate left: unknown ("?"), not "0s" while it still runs.
-  EXPECT_LT(m.remaining_s({}, {{3, 400.0, e400 + 10.0}}, 2), 0);
-  EXPECT_EQ(format_duration(m.remaining_s({}, {{3, 400.0, e400 + 10.0}}, 2)), "?");
+  EXPECT_LT(m.remaining_s({running(400.0, e400 + 10.0)}, 2), 0);
+  EXPECT_EQ(format_duration(m.remaining_s({running(400.0, e400 + 10.0)}, 2)), "?");
+}
+
+// Found on the certified Table 1: a level-4 case resumed at γ̇t = 30 of 40 was counted whole, so `campaign
+// status` and the runner's ETA put four times its remaining work on it. A case with a checkpoint counts the
+// part after it, queued or running.
+TEST(EtaModel, AResumedCaseCountsOnlyThePartAfterItsCheckpoint) {
+  EtaModel m;
+  m.add_done(3, 100.0, 400.0);
+  const double whole = m.expected_s(3, 100.0);
+  EXPECT_NEAR(m.remaining_s({{3, 100.0, 0.25}}, 1), 0.25 * whole, 1e-9);
+  // Resumed with a quarter left and running for a tenth of the whole since: 0.15 of it to go.
+  EXPECT_NEAR(m.remaining_s({{3, 100.0, 0.25, true, 0.1 * whole}}, 1), 0.15 * whole, 1e-9);
+  // Past even the remaining part's prediction: unknown, not negative work.
+  EXPECT_LT(m.remaining_s({{3, 100.0, 0.25, true, 0.3 * whole}}, 1), 0);
+  // A fraction outside [0, 1] (a checkpoint past t_end after a t_end change) is clamped, not extrapolated.
+  EXPECT_NEAR(m.remaining_s({{3, 100.0, 1.5}}, 1), whole, 1e-9);
+  EXPECT_NEAR(m.remaining_s({{3, 100.0, -0.5}, {3, 100.0}}, 1), whole, 1e-9);
 }
 
 }  // namespace

@@ -175,6 +175,36 @@ std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups
     Proposals p{check ? check->case_ca : kNone, {}};
     const Transition t = analyse_group(answer.key, answer.samples, o.d12_threshold);
     for (const auto& x : bracketing_ca(t)) p.add(x);
+    if (check) {
+      // Where the check level's values at a bracket lie on one side of the target (its answer is outside the
+      // bracket), the answer level's next sample outwards, one at a time, until the check level brackets it
+      // on its own (check_level_crossing); nothing while the check level's last such case is still to run.
+      const std::vector<double> answer_ca = sampled_ca(answer);
+      auto outwards = [&](bool of_ca_h, const std::optional<double>& a, const std::optional<double>& b) {
+        if (!a || !b) return;
+        const LevelCrossing c = check_level_crossing(*check, answer_ca, of_ca_h, *a, *b, o.d12_threshold);
+        if (!c.extrapolated || !c.ca) return;
+        // The first answer-level sample outwards at which the check level has no value yet.
+        const bool up = *c.ca > std::max(*a, *b);
+        const double edge = up ? std::max(*a, *b) : std::min(*a, *b);
+        std::vector<double> beyond;
+        for (double x : answer_ca)
+          if (up ? x > edge && !same_ca(x, edge) : x < edge && !same_ca(x, edge)) beyond.push_back(x);
+        if (!up) std::reverse(beyond.begin(), beyond.end());  // outwards (answer_ca is sorted)
+        for (double x : beyond) {
+          const auto same = [&](double y) { return same_ca(x, y); };
+          bool valued = false;
+          for (const auto& s : check->samples) valued |= same_ca(s.ca, x) && (of_ca_h ? s.max_tau_min : s.min_d12);
+          if (valued) continue;
+          // The next one to run; a check case there without a value yet (queued, running): wait for it.
+          if (std::none_of(check->case_ca.begin(), check->case_ca.end(), same)) p.add(x);
+          return;
+        }
+      };
+      outwards(true, t.ca_h_low, t.ca_h_high);
+      outwards(false, t.ca_star_below, t.ca_star_low);
+      outwards(false, t.ca_star_high, t.ca_star_above);
+    }
     if (!emit(answer.base, o.levels[2], p.ca, out, budget)) break;
   }
   return out;

@@ -19,7 +19,9 @@
 /// 5. **dt check** (dt_check = true): the CaH-low case of each cell (else its Ca*-low case) on the answer
 ///    level with time.dt = half the step it ran with;
 /// 6. **check** (a third level): the final bracketing cases of every answer re-run on the check level,
-///    which gives the mesh part of the error (analysis/uncertainty.h).
+///    which gives the mesh part of the error (analysis/uncertainty.h); where the check level's two values
+///    lie on one side of the target (its answer is outside the answer level's bracket), the answer level's
+///    next sample outwards too, one at a time, until the check level brackets its answer itself.
 /// Phases 2–4 repeat as rounds until none adds a case; 5 and 6 run once, after them (the cheap dt check
 /// first, so that a campaign interrupted among the check level's long cases has it).
 

@@ -79,9 +79,13 @@ std::optional<double> crossing(double a, double ya, double b, double yb, double 
 }
 
 // The answer of another level g2 near the bracket (a, b) of the answer level: the crossing of the line
-// through g2's values at a and b when g2 has both (a check level run at the brackets; extrapolated if they do
-// not straddle), else g2's own answer from its own bracket (a scan level sampled elsewhere).
-std::optional<double> level_answer(const SampleGroup& g2, Answer which, double a, double b, double thr) {
+// through g2's values at a and b when g2 has both (a check level run at the brackets; for a level finer than
+// the answer group `finer_than`, check_level_crossing: its own bracket beyond them at the answer level's
+// samples where they do not straddle), else g2's own answer from
+// its own bracket (a scan level sampled elsewhere). `extrapolated`: a line through g2's values at a and b
+// that does not straddle the target.
+LevelCrossing level_answer(const SampleGroup& g2, Answer which, double a, double b, double thr,
+                           const SampleGroup* finer_than) {
   const Quantity q = which == Answer::kCaH ? Quantity::kMaxTauMin : Quantity::kMinD12;
   const double target = which == Answer::kCaH ? 0.0 : thr;
   std::optional<double> ya, yb;
@@ -89,19 +93,26 @@ std::optional<double> level_answer(const SampleGroup& g2, Answer which, double a
     if (same_ca(s.ca, a)) ya = value(s, q);
     if (same_ca(s.ca, b)) yb = value(s, q);
   }
-  if (ya && yb) return crossing(a, *ya, b, *yb, target);
+  if (ya && yb) {
+    if (finer_than) {
+      std::vector<double> answer_ca;
+      for (const auto& s : finer_than->samples) answer_ca.push_back(s.ca);
+      return check_level_crossing(g2, answer_ca, which == Answer::kCaH, a, b, thr);
+    }
+    return {crossing(a, *ya, b, *yb, target), (*ya - target) * (*yb - target) > 0};
+  }
   const Transition t2 = analyse_group(g2.key, g2.samples, thr);
-  if (which == Answer::kCaH) return t2.ca_h;
+  if (which == Answer::kCaH) return {t2.ca_h, false};
   const auto& in = which == Answer::kCaStarLow ? t2.ca_star_low : t2.ca_star_high;
   const auto& out = which == Answer::kCaStarLow ? t2.ca_star_below : t2.ca_star_above;
-  if (!in || !out) return std::nullopt;
+  if (!in || !out) return {};
   std::optional<double> y_in, y_out;
   for (const auto& s : g2.samples) {
     if (same_ca(s.ca, *in)) y_in = s.min_d12;
     if (same_ca(s.ca, *out)) y_out = s.min_d12;
   }
-  if (!y_in || !y_out) return std::nullopt;
-  return crossing(*in, *y_in, *out, *y_out, thr);
+  if (!y_in || !y_out) return {};
+  return {crossing(*in, *y_in, *out, *y_out, thr), false};
 }
 
 // The largest |q_L2(c) − q_L(c)| over the bracket Ca c ∈ {a, b} where both groups have q (nullopt: none).
@@ -133,14 +144,11 @@ Part mesh_part(const Cell& cell, int level, Answer which, double a, double b, do
   auto take = [&](int l, std::optional<double>& out) {
     auto it = cell.by_level.find(l);
     if (it == cell.by_level.end()) return;
-    out = level_answer(*it->second, which, a, b, thr);
-    // Only a crossing extrapolated from that level's own samples at a and b can be "far" (a scan level's
-    // own answer from its own bracket elsewhere is a real mesh difference, however large).
-    bool at_both = false, at_a = false, at_b = false;
-    for (const auto& s2 : it->second->samples)
-      if (value(s2, q)) at_a |= same_ca(s2.ca, a), at_b |= same_ca(s2.ca, b);
-    at_both = at_a && at_b;
-    if (!out || !at_both || !far(*out)) return;
+    const LevelCrossing c = level_answer(*it->second, which, a, b, thr, l > level ? cell.by_level.at(level) : nullptr);
+    out = c.ca;
+    // Only a crossing extrapolated from that level's own samples at a and b can be "far" (its own answer
+    // from its own bracket, elsewhere or beyond, is a real mesh difference, however large).
+    if (!out || !c.extrapolated || !far(*out)) return;
     far_level.insert(l);
     const auto d = value_difference(*it->second, *cell.by_level.at(level), q, a, b);
     if (d && std::fabs(slope) > 0 && std::isfinite(slope)) {
@@ -329,6 +337,39 @@ AnswerError edge_error(const std::optional<double>& inside, const std::optional<
 }
 
 }  // namespace
+
+LevelCrossing check_level_crossing(const SampleGroup& g, const std::vector<double>& answer_ca, bool of_ca_h, double a,
+                                   double b, double d12_threshold) {
+  const Quantity q = of_ca_h ? Quantity::kMaxTauMin : Quantity::kMinD12;
+  const double target = of_ca_h ? 0.0 : d12_threshold;
+  auto at = [&](double x) -> std::optional<double> {
+    for (const auto& s : g.samples)
+      if (same_ca(s.ca, x) && value(s, q)) return value(s, q);
+    return std::nullopt;
+  };
+  const double lo = std::min(a, b), hi = std::max(a, b);
+  const auto y_lo = at(lo), y_hi = at(hi);
+  if (!y_lo || !y_hi) return {};
+  const auto line = crossing(lo, *y_lo, hi, *y_hi, target);
+  if ((*y_lo - target) * (*y_hi - target) <= 0 || !line) return {line, false};
+  // One side of the target at both: walk the answer level's samples outwards from the bracket while g has
+  // them; the first where g's value changes side closes g's own bracket.
+  const bool up = *line > hi;
+  std::vector<double> beyond;
+  for (double x : answer_ca)
+    if (up ? x > hi && !same_ca(x, hi) : x < lo && !same_ca(x, lo)) beyond.push_back(x);
+  std::sort(beyond.begin(), beyond.end());
+  if (!up) std::reverse(beyond.begin(), beyond.end());
+  double x0 = up ? hi : lo, y0 = up ? *y_hi : *y_lo;
+  for (double x : beyond) {
+    const auto y = at(x);
+    if (!y) break;
+    if ((y0 - target) * (*y - target) <= 0) return {crossing(x0, y0, x, *y, target), false};
+    x0 = x;
+    y0 = *y;
+  }
+  return {line, true};
+}
 
 std::string cell_key(const std::string& group_key) {
   auto j = nlohmann::json::parse(group_key, nullptr, false);

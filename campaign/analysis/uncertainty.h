@@ -13,8 +13,9 @@
 /// - **mesh**, compared as answers (in Ca): the answer level's value A_L (CaH, or for a Ca* edge the
 ///   threshold crossing of the line through its inside and outside samples) against the neighbouring levels'
 ///   A_{L±1} — the crossing of the line through that level's values at the same two Ca when it has both (a
-///   check level run at the brackets; extrapolated if they do not straddle), else its own answer from its own
-///   bracket (a scan level sampled elsewhere; comparing answers, not values interpolated across a coarse
+///   check level run at the brackets; where they do not straddle, the finer level's crossing in its own
+///   bracket beyond them when it has one — check_level_cases runs it outwards until it does — else
+///   extrapolated), else its own answer from its own bracket (a scan level sampled elsewhere; comparing answers, not values interpolated across a coarse
 ///   grid, keeps the V of min D12 from posing as a mesh error). With both neighbours and monotone
 ///   differences d₁ = A_L − A_{L−1}, d₂ = A_{L+1} − A_L (same sign, |d₂| < |d₁|): Richardson with the observed
 ///   ratio r = d₂/d₁, e = |d₂| / (1 − r) (the distance from A_L to the extrapolated limit; observed order
@@ -82,6 +83,27 @@ struct GroupErrors {
   AnswerError ca_star_low, ca_star_high, ca_h;
   std::string levels;  ///< levels that entered the mesh part, e.g. "2,3"
 };
+
+/// @brief Where a finer (check) level puts an answer that the answer level brackets by the samples a, b.
+struct LevelCrossing {
+  std::optional<double> ca;   ///< nullopt: the level lacks a value at a or b, or its two values are equal
+  /// The level's values at a and b lie on one side of the target and none of its samples beyond the bracket
+  /// (in the direction their line points) straddles it: `ca` is the line's extrapolated crossing, and the
+  /// level needs a sample further out (check_level_cases proposes the answer level's next one).
+  bool extrapolated = false;
+};
+
+/// @brief The crossing of the target (0 by max τmin for CaH when @p of_ca_h, else @p d12_threshold by min D12)
+/// on the level of @p g near the bracket (a, b) of the answer level, whose sampled Ca are @p answer_ca: the
+/// line through g's values at a and b when they straddle the target; where they do not, g's answer lies
+/// outside the bracket, and it is found by walking the answer level's samples outwards (in the direction the
+/// line points) while g has values there: the first whose value is on the other side closes g's own bracket,
+/// interpolated, not extrapolated. Else the line's extrapolated crossing, flagged. Only the answer level's
+/// neighbours count, so a far sample of g (a Ca* case of the same cell) does not make a bracket across half
+/// the range. Why: level 4 of the certified Table 1 moves two CaH past their level-3 brackets (both level-4
+/// max τmin of one sign); an extrapolation across a curved τ(Ca) is not an answer of that level.
+LevelCrossing check_level_crossing(const SampleGroup& g, const std::vector<double>& answer_ca, bool of_ca_h, double a,
+                                   double b, double d12_threshold);
 
 /// @brief Role of every group (groups[i] -> result[i]) under @p options; see the file comment.
 std::vector<std::string> group_roles(const std::vector<SampleGroup>& groups, const ErrorOptions& options);

@@ -162,6 +162,36 @@ TEST(MultiFidelity, TheCheckLevelRunsTheFinalBrackets) {
   EXPECT_TRUE(check_level_cases(group_cases(cases), o, 0).empty()) << "no budget";
 }
 
+// Where the check level's values at the final bracket lie on one side of 0 (its CaH is outside the bracket),
+// the answer level's next sample outwards is run on the check level, one at a time, until it brackets CaH.
+TEST(MultiFidelity, TheCheckLevelGoesOutwardsUntilItBracketsItsAnswer) {
+  const auto tau4 = [](double ca) { return 0.72 - ca; };  // level 4: CaH 0.72, past level 3's (0.55, 0.65)
+  std::vector<CaseSample> cases;
+  for (double ca : {0.1, 0.2, 0.5, 1.0}) cases.push_back(fake(2, ca, tau2));
+  for (double ca : {0.1, 0.55, 0.65, 0.8, 1.0}) cases.push_back(fake(3, ca, tau3));
+  MultiFidelityOptions o = kOptions;
+  o.levels = {2, 3, 4};
+  for (double ca : {0.55, 0.65}) cases.push_back(fake(4, ca, tau4));
+  EXPECT_EQ(ca_at(check_level_cases(group_cases(cases), o, 100), 4), (std::vector<double>{0.8}));
+  cases.push_back(fake(4, 0.8, tau4, "running"));
+  EXPECT_TRUE(check_level_cases(group_cases(cases), o, 100).empty()) << "waits for the case it needs";
+  cases.back() = fake(4, 0.8, tau4);
+  EXPECT_TRUE(check_level_cases(group_cases(cases), o, 100).empty()) << "bracketed by 0.65 and 0.8";
+  // Still on one side at 0.8 (level-4 CaH 0.9): the next one, 1.0.
+  std::vector<CaseSample> further(cases.begin(), cases.end() - 3);
+  const auto tau4b = [](double ca) { return 0.9 - ca; };
+  for (double ca : {0.55, 0.65, 0.8}) further.push_back(fake(4, ca, tau4b));
+  EXPECT_EQ(ca_at(check_level_cases(group_cases(further), o, 100), 4), (std::vector<double>{1.0}));
+  // Below the bracket (level-4 CaH 0.3): the answer level's sample below 0.55 is 0.1.
+  std::vector<CaseSample> below(cases.begin(), cases.end() - 3);
+  for (double ca : {0.55, 0.65}) below.push_back(fake(4, ca, [](double ca) { return 0.3 - ca; }));
+  EXPECT_EQ(ca_at(check_level_cases(group_cases(below), o, 100), 4), (std::vector<double>{0.1}));
+  // A check level that brackets at the final bracket needs nothing more.
+  std::vector<CaseSample> inside(cases.begin(), cases.end() - 3);
+  for (double ca : {0.55, 0.65}) inside.push_back(fake(4, ca, [](double ca) { return 0.62 - ca; }));
+  EXPECT_TRUE(check_level_cases(group_cases(inside), o, 100).empty());
+}
+
 TEST(MultiFidelity, TheDtCheckHalvesTheStepOfTheCaHLowCase) {
   std::vector<CaseSample> cases;
   for (double ca : {0.1, 0.2, 0.5, 1.0}) cases.push_back(fake(2, ca, tau2));

@@ -145,6 +145,53 @@ TEST(Uncertainty, NonMonotoneDifferencesFallBackToTheLastDifference) {
   EXPECT_NE(a.at(3).error_note.find("difference to level 4"), std::string::npos) << a.at(3).error_note;
 }
 
+// Level 4 of the certified Table 1 put the oblate NH CaH past its level-3 bracket (both level-4 max τmin > 0):
+// the line through them, extrapolated across a curved τ(Ca), is no answer of level 4. With a level-4 sample
+// beyond (check_level_cases runs one), level 4's answer is its own crossing in its own bracket.
+TEST(Uncertainty, ACheckLevelBeyondTheBracketAnswersInItsOwnBracket) {
+  const auto tau4 = [](double ca) { return 0.7 - ca - 2 * (ca - 0.5) * (ca - 0.5); };  // concave
+  std::vector<CaseSample> cases;
+  add(cases, {.level = 3, .ca = {0.4, 0.5, 0.625, 1.0}, .tau = [](double ca) { return 0.6 - ca; }});
+  add(cases, {.level = 4, .ca = {0.5, 0.625}, .tau = tau4});
+  const double extrapolated = 0.625 + tau4(0.625) / ((tau4(0.5) - tau4(0.625)) / 0.125);  // 0.66
+  {
+    const auto a = analyse(cases, {2, 3, 4});
+    ASSERT_EQ(a.at(3).level_answers.count("ca_h"), 1u);
+    EXPECT_NEAR(a.at(3).level_answers.at("ca_h").at(4), extrapolated, 1e-12);
+    const auto g = group_cases(cases);
+    for (const auto& grp : g)
+      if (grp.key.mesh_level == 4) {
+        const LevelCrossing c = check_level_crossing(grp, {0.4, 0.5, 0.625, 1.0}, true, 0.5, 0.625, 0.05);
+        EXPECT_TRUE(c.extrapolated);
+        ASSERT_TRUE(c.ca);
+        EXPECT_NEAR(*c.ca, extrapolated, 1e-12);
+      }
+  }
+  add(cases, {.level = 4, .ca = {1.0}, .tau = tau4});
+  const auto a = analyse(cases, {2, 3, 4});
+  const double own = 0.625 + 0.375 * tau4(0.625) / (tau4(0.625) - tau4(1.0));  // 0.644
+  EXPECT_GT(std::fabs(own - extrapolated), 0.01);
+  EXPECT_NEAR(a.at(3).level_answers.at("ca_h").at(4), own, 1e-12);
+  ASSERT_TRUE(a.at(3).ca_h_err);
+  EXPECT_NEAR(*a.at(3).ca_h_err, own - 0.6, 1e-12);  // the difference to level 4, not a "far" value comparison
+  EXPECT_NE(a.at(3).error_note.find("difference to level 4"), std::string::npos) << a.at(3).error_note;
+  // The same below the bracket (both level-4 values negative: its CaH lies below).
+  std::vector<CaseSample> down;
+  add(down, {.level = 3, .ca = {1.0, 1.264, 1.5}, .tau = [](double ca) { return 1.3 - ca; }});
+  add(down, {.level = 4, .ca = {1.0, 1.264, 1.5}, .tau = [](double ca) { return 1.25 - ca; }});
+  for (const auto& grp : group_cases(down))
+    if (grp.key.mesh_level == 4) {
+      const LevelCrossing c = check_level_crossing(grp, {1.0, 1.264, 1.5}, true, 1.264, 1.5, 0.05);
+      EXPECT_FALSE(c.extrapolated);
+      ASSERT_TRUE(c.ca);
+      EXPECT_NEAR(*c.ca, 1.25, 1e-12);
+      // Only the answer level's neighbours close a bracket: without 1.0 among its samples, a level-4 sample
+      // at 1.0 (another answer's case) is not used, and the crossing stays an extrapolation.
+      const LevelCrossing far = check_level_crossing(grp, {1.264, 1.5}, true, 1.264, 1.5, 0.05);
+      EXPECT_TRUE(far.extrapolated);
+    }
+}
+
 TEST(Uncertainty, TheLargestPartIsCarriedAndNamed) {
   std::vector<CaseSample> cases;
   // Periods: max τmin moves by 0.03 between periods; mesh difference 0.01; slope 2 → 0.015 in Ca.

@@ -96,12 +96,21 @@ class Runner {
       if (r.status == "queued" && !interrupted_.count(r.case_id)) pending.push_back(r);
     // longest first keeps the workers busy to the end of a campaign that finishes (the long cases do not
     // start last); shortest first completes the most answers per hour of one that will be interrupted.
-    if (opt_.order == "longest")
-      std::stable_sort(pending.begin(), pending.end(),
-                       [](const CaseRow& a, const CaseRow& b) { return a.est_cost > b.est_cost; });
-    else if (opt_.order == "shortest")
-      std::stable_sort(pending.begin(), pending.end(),
-                       [](const CaseRow& a, const CaseRow& b) { return a.est_cost < b.est_cost; });
+    // Both by the work left: a case that resumes from a checkpoint at γ̇t = 30 of 40 is a quarter of a case
+    // (an interrupted level-4 case is then finished first by `--order shortest`, not left behind whole ones).
+    if (opt_.order == "longest" || opt_.order == "shortest") {
+      // The whole case as the ETA predicts it (wall ∝ est^β per level), the estimate itself before any finished.
+      std::map<std::string, double> left;
+      for (const auto& r : pending) {
+        const double whole = eta_.expected_s(r.params.mesh_level(), r.est_cost);
+        left[r.case_id] = (whole >= 0 ? whole : r.est_cost) *
+                          (r.resumable ? work_fraction_left(r.out_dir, r.params.t_end()) : 1.0);
+      }
+      const bool longest = opt_.order == "longest";
+      std::stable_sort(pending.begin(), pending.end(), [&](const CaseRow& a, const CaseRow& b) {
+        return longest ? left[a.case_id] > left[b.case_id] : left[a.case_id] < left[b.case_id];
+      });
+    }
     total_ = static_cast<int>(rows.size());
     finished_ = failed_ = 0;
     for (auto& r : rows) {

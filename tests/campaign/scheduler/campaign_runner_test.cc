@@ -3,6 +3,8 @@
 // `campaign analyse`, which recomputes the stored transitions.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "campaign/scheduler/campaign_runner.h"
 #include "campaign/store/sqlite_db.h"
 #include "tests/campaign/test_util.h"
@@ -37,6 +39,40 @@ TEST(CampaignRunner, LongestFirstStartsTheSmallestCaFirst) {
 
 TEST(CampaignRunner, ShortestFirstStartsTheLargestCaFirst) {
   EXPECT_EQ(started_order("shortest"), "0.06\n0.05\n0.04\n0.03\n0.02\n0.01\n");
+}
+
+// The order counts the work left: a case that resumes from a checkpoint near its end is the shortest, so
+// `--order shortest` finishes an interrupted case before starting whole ones (and `longest` starts it last).
+TEST(CampaignRunner, AResumedCaseIsOrderedByTheWorkItHasLeft) {
+  const std::string dir = fresh_dir("runner_order_resumed");
+  const std::string db = dir + "/study.db";
+  // t_end = 0.11: a checkpoint at γ̇t = 0.1 leaves 9 % of the case, less than 0.01's estimate over 0.06's (1/6).
+  std::string six = kSix;
+  six.replace(six.find("mesh.level = 1\n"), 15, "mesh.level = 1\ntime.t_end = 0.11\n");
+  write_file(dir + "/c.toml", six);
+  ASSERT_EQ(sh(campaign_cmd("FAKE_STEPS=1", dir + "/c.toml", db, "--jobs 1")).code, 0);
+  const auto real = sh(exe() + " run - --set mesh.level=1 --set time.dt=0.02 --stop-after 5 --threads 1 --quiet --out " +
+                       dir + "/real");
+  ASSERT_EQ(real.code, 3) << real.err;
+  std::string folder = sql(db, "SELECT out_dir FROM cases WHERE capillary_number = 0.01");
+  while (!folder.empty() && (folder.back() == '\n' || folder.back() == '\r')) folder.pop_back();
+  ASSERT_FALSE(folder.empty());
+  std::filesystem::copy_file(dir + "/real/checkpoint.h5", folder + "/checkpoint.h5",
+                             std::filesystem::copy_options::overwrite_existing);
+  write_file(folder + "/checkpoint.txt", "0\n");  // what the stand-in worker resumes from
+  for (const std::string order : {"shortest", "longest"}) {
+    {
+      Db d(db, false, false);
+      d.exec("DELETE FROM attempts; UPDATE cases SET status = 'queued'; "
+             "UPDATE cases SET resumable = 1 WHERE capillary_number = 0.01");
+    }
+    auto r = sh(campaign_cmd("FAKE_STEPS=1", dir + "/c.toml", db, "--jobs 1 --order " + order));
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::string got =
+        sql(db, "SELECT c.capillary_number FROM attempts a JOIN cases c USING(case_id) ORDER BY a.attempt_id");
+    if (order == "shortest") EXPECT_EQ(got, "0.01\n0.06\n0.05\n0.04\n0.03\n0.02\n");
+    else EXPECT_EQ(got, "0.02\n0.03\n0.04\n0.05\n0.06\n0.01\n");
+  }
 }
 
 // `capsim campaign analyse` recomputes the stored transitions from the cases (after a change of the analysis,

@@ -12,6 +12,7 @@
 #include "capsim/version.h"
 #include "solver/driver/case_driver.h"
 #include "solver/solver_version.h"
+#include "solver/stokes/stokeslet.h"
 
 namespace capsim::driver {
 namespace {
@@ -142,6 +143,7 @@ CaseSummary CaseSummary::of(const config::CaseConfig& config, const CaseResult& 
   s.threads = omp_get_max_threads();
   s.case_file = r.case_file.empty() ? std::string() : std::filesystem::absolute(r.case_file).string();
   s.code_version = kGitCommit;
+  s.kernel_isa = stokes::kernel::kernel_isa();
   s.solver_version = kSolverVersion;
   return s;
 }
@@ -164,6 +166,7 @@ nlohmann::json CaseSummary::to_json() const {
       {"threads", threads},
       {"case_file", case_file},
       {"code_version", code_version},
+      {"kernel_isa", kernel_isa},
       {"solver_version", solver_version},
   };
   for (const auto& f : kAnalysisFields) j[f.name] = json_number(analysis.*f.member);
@@ -199,6 +202,7 @@ CaseSummary CaseSummary::from_json(const nlohmann::json& j) {
   s.threads = static_cast<int>(integer_or_zero(j, "threads"));
   s.case_file = string_or_empty(j, "case_file");
   s.code_version = string_or_empty(j, "code_version");
+  s.kernel_isa = string_or_empty(j, "kernel_isa");  // absent in results from before it: ""
   s.solver_version = string_or_empty(j, "solver_version");
   for (const auto& f : kAnalysisFields) s.analysis.*f.member = number_or_nan(j, f.name);
   for (const auto& f : kNumberFields) f.set(s, number_or_nan(j, f.name));
@@ -221,6 +225,7 @@ std::vector<io::Attribute> summary_attributes(const CaseSummary& s) {
   a.emplace_back("flow_evaluations", s.flow_evaluations);
   a.emplace_back("threads", s.threads);
   a.emplace_back("solver_version", s.solver_version);
+  a.emplace_back("kernel_isa", s.kernel_isa);
   // code_version is the case file's own reserved attribute (written by io::CaseWriter, same value).
   for (const auto& f : kAnalysisFields) a.emplace_back(f.name, s.analysis.*f.member);
   for (const auto& f : kNumberFields) a.emplace_back(f.name, f.get(s));

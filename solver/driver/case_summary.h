@@ -58,6 +58,10 @@ struct CaseSummary {
   int threads = 0;
   std::string case_file;  ///< absolute path of case.h5
   std::string code_version;    ///< git commit of the build
+  /// Instruction set of the Stokeslet kernel of the build that ran (the last invocation of a resumed case):
+  /// "avx512", "avx2" or "portable". Their 1/r refinements round differently, so two builds of one commit
+  /// on different machines agree to round-off, not bit for bit (campaign/README.md, "Resumption guarantees").
+  std::string kernel_isa;
   std::string solver_version;  ///< capsim::kSolverVersion (enters case identities)
 
   /// @brief The summary of a run of @p config: parameters from the configuration, results from @p result,

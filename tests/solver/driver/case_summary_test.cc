@@ -9,6 +9,7 @@
 
 #include "solver/driver/case_driver.h"
 #include "solver/io/case_file.h"
+#include "solver/stokes/stokeslet.h"
 
 namespace capsim::driver {
 namespace {
@@ -35,6 +36,7 @@ CaseSummary example() {
   s.case_file = "/tmp/x/case.h5";
   s.code_version = "abc";
   s.solver_version = "2";
+  s.kernel_isa = "avx2";
   return s;
 }
 
@@ -53,6 +55,23 @@ TEST(CaseSummary, JsonRoundTripKeepsEveryField) {
   EXPECT_EQ(t.wrinkle_final.wrinkle_amplitude, 1e-3);
   EXPECT_EQ(t.wrinkle_max.wrinkle_wavelength, 0.7);
   EXPECT_EQ(t.wrinkle_max.wrinkle_amplitude, 2e-3);
+  EXPECT_EQ(t.kernel_isa, "avx2");
+}
+
+// A result line from before kernel_isa existed still reads (the committed databases hold thousands).
+TEST(CaseSummary, FromJsonReadsAResultWithoutTheKernelIsa) {
+  nlohmann::json j = example().to_json();
+  j.erase("kernel_isa");
+  EXPECT_EQ(CaseSummary::from_json(j).kernel_isa, "");
+}
+
+// The summary of a run names the instruction set of the kernel that computed it, the one the build reports.
+TEST(CaseSummary, OfARunNamesTheKernelsInstructionSet) {
+  config::CaseConfig c;
+  CaseResult r;
+  const CaseSummary s = CaseSummary::of(c, r);
+  EXPECT_EQ(s.kernel_isa, stokes::kernel::kernel_isa());
+  EXPECT_TRUE(s.kernel_isa == "avx512" || s.kernel_isa == "avx2" || s.kernel_isa == "portable") << s.kernel_isa;
 }
 
 // The keys campaign/README.md, "The worker contract" and the scripts rely on.
@@ -64,7 +83,7 @@ TEST(CaseSummary, JsonHasTheContractKeys) {
                           "max_load_roughness", "wrinkle_wavelength", "wrinkle_amplitude", "max_wrinkle_amplitude",
                           "wrinkle_wavelength_of_max", "steps", "flow_evaluations", "dt", "t_final",
                           "wall_s", "threads",
-                          "case_file", "code_version", "solver_version"})
+                          "case_file", "code_version", "kernel_isa", "solver_version"})
     EXPECT_TRUE(j.contains(key)) << key;
 }
 

@@ -12,20 +12,22 @@
 namespace capsim::campaign::testing {
 namespace {
 
-void expect_query_reproduces(const std::string& db_name, const std::string& json_name) {
+void expect_query_reproduces(const std::string& db_name, const std::string& json_name, const std::string& campaign = "",
+                             std::size_t rows = 6) {
   const fs::path results = fs::path(CAPSIM_SOURCE_DIR) / "results";
   // Both files are committed deliverables: a missing one is a failure, not a reason to skip.
   ASSERT_TRUE(fs::exists(results / db_name)) << "results/" << db_name << " is missing";
   ASSERT_TRUE(fs::exists(results / json_name)) << "results/" << json_name << " is missing";
-  const std::string dir = fresh_dir("committed_" + db_name);
-  const std::string copy = dir + "/" + db_name;
+  const std::string dir = fresh_dir("committed_" + fs::path(json_name).stem().string());
+  const std::string copy = dir + "/" + fs::path(db_name).filename().string();
   fs::copy_file(results / db_name, copy);
-  const CmdResult r = sh(exe() + " query table1 --db " + copy + " --format json");
+  const std::string which = campaign.empty() ? "" : " --campaign " + campaign;
+  const CmdResult r = sh(exe() + " query table1 --db " + copy + which + " --format json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto ours = nlohmann::json::parse(r.out);
   const auto committed = nlohmann::json::parse(read_file((results / json_name).string()));
   ASSERT_TRUE(ours.is_array());
-  EXPECT_EQ(ours.size(), 6u) << "two laws x three aspect ratios";
+  EXPECT_EQ(ours.size(), rows) << "two laws x three aspect ratios, or the cells the campaign has";
   EXPECT_EQ(ours, committed) << "results/" << json_name << " is stale: regenerate it with capsim query table1";
 }
 
@@ -43,6 +45,17 @@ TEST(CommittedResults, MultiFidelityTableIsWhatTheDatabaseGives) {
 // campaign is the most recently run, the certified one.
 TEST(CommittedResults, CertifiedTableIsWhatTheDatabaseGives) {
   expect_query_reproduces("table1_certified.sqlite", "table1_certified.json");
+}
+
+// Figure 6 (results/bending/README.md §8.2) is drawn from these two query outputs; their databases hold
+// several campaigns each, so the campaign is named.
+TEST(CommittedResults, BendingTableIsWhatTheDatabaseGives) {
+  expect_query_reproduces("bending/table1_bending.sqlite", "bending/table1_kb1e-3.json", "table1-bending-1e-3");
+}
+
+TEST(CommittedResults, OblateTransitionAtSmallBendingIsWhatTheDatabaseGives) {
+  expect_query_reproduces("bending/oblate_regime.sqlite", "bending/oblate_regime_kb1e-4.json",
+                          "bending-oblate-regime-1e-4", 1);
 }
 
 }  // namespace

@@ -71,7 +71,7 @@ TEST(CaseSummary, OfARunNamesTheKernelsInstructionSet) {
   CaseResult r;
   const CaseSummary s = CaseSummary::of(c, r);
   EXPECT_EQ(s.kernel_isa, stokes::kernel::kernel_isa());
-  EXPECT_TRUE(s.kernel_isa == "avx512" || s.kernel_isa == "avx2" || s.kernel_isa == "portable") << s.kernel_isa;
+  EXPECT_FALSE(s.kernel_isa.empty());  // the names themselves belong to solver/stokes/stokeslet.cc
 }
 
 // The keys campaign/README.md, "The worker contract" and the scripts rely on.

@@ -43,6 +43,9 @@ struct Transition {
   std::optional<double> ca_star_low_err, ca_star_high_err, ca_h_err;
   /// @brief The largest part of each error: "mesh", "periods", "dt" or "bracket" (a Ca* edge's sampling).
   std::string ca_star_low_err_source, ca_star_high_err_source, ca_h_err_source;
+  /// @brief The parts of each error that had no data (AnswerError::lacks: e.g. "mesh,dt"; "" when complete or
+  /// without an error): where not empty the error is a lower bound.
+  std::string ca_star_low_err_lacks, ca_star_high_err_lacks, ca_h_err_lacks;
   std::string error_levels;  ///< mesh levels whose values entered the mesh part, e.g. "2,3"
   std::string error_note;    ///< provenance: every part of every error and how it was obtained
   /// @brief Each answer ("ca_star_low", "ca_star_high", "ca_h") on the other levels its mesh error compared

@@ -338,6 +338,13 @@ AnswerError edge_error(const std::optional<double>& inside, const std::optional<
 
 }  // namespace
 
+std::string AnswerError::lacks() const {
+  std::string out;
+  for (const auto& [part, name] : {std::pair{&mesh, "mesh"}, std::pair{&periods, "periods"}, std::pair{&dt, "dt"}})
+    if (!*part) out += (out.empty() ? "" : ",") + std::string(name);
+  return out;
+}
+
 LevelCrossing check_level_crossing(const SampleGroup& g, const std::vector<double>& answer_ca, bool of_ca_h, double a,
                                    double b, double d12_threshold) {
   const Quantity q = of_ca_h ? Quantity::kMaxTauMin : Quantity::kMinD12;
@@ -434,6 +441,9 @@ void estimate_errors(std::vector<Transition>& rows, const std::vector<SampleGrou
     t.ca_h_err_source = e.ca_h.total ? e.ca_h.source : "";
     t.ca_star_low_err_source = e.ca_star_low.total ? e.ca_star_low.source : "";
     t.ca_star_high_err_source = e.ca_star_high.total ? e.ca_star_high.source : "";
+    t.ca_h_err_lacks = e.ca_h.total ? e.ca_h.lacks() : "";
+    t.ca_star_low_err_lacks = e.ca_star_low.total ? e.ca_star_low.lacks() : "";
+    t.ca_star_high_err_lacks = e.ca_star_high.total ? e.ca_star_high.lacks() : "";
     t.error_levels = e.levels;
     t.error_note.clear();
     auto add = [&](const char* name, const AnswerError& a) {

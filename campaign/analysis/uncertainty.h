@@ -43,7 +43,8 @@
 ///   outwards (widened away from the band in the same way). Its source is "bracket" when the gap is the
 ///   larger part.
 /// A part that has no data (no other level, periods not recorded, no dt_check) is left out and said so in
-/// the note; with no part at all a CaH error is unknown (nullopt) and a Ca* edge's error is its gap.
+/// the note and in AnswerError::lacks (Transition::*_err_lacks): the error is then a lower bound. With no part
+/// at all a CaH error is unknown (nullopt) and a Ca* edge's error is its gap.
 
 #include <map>
 #include <optional>
@@ -76,6 +77,10 @@ struct AnswerError {
   /// @brief The same answer on the other levels of the cell that the mesh part compared (level -> Ca;
   /// for a Ca* edge the threshold crossing at the bracket, see the file comment): what a check level says.
   std::map<int, double> on_level;
+  /// @brief The parts with no data, "mesh", "periods", "dt" in that order and comma-separated ("" when all three
+  /// entered). `total` is then a lower bound of the error: e.g. a CaH of a campaign with one level and no dt check
+  /// carries the period spread alone. `capsim query table1` marks such an answer's ± (schemas/006).
+  [[nodiscard]] std::string lacks() const;
 };
 
 /// @brief The errors of the three answers of one group.

@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -97,7 +98,8 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
     campaign::Table t;
     t.columns = {"law",          "aspect_ratio",     "ca_star_low", "ca_star_high", "ca_h",
                  "ca_star_low_err", "ca_star_high_err", "ca_h_err",    "mesh_level",   "error_levels",
-                 "ca_star_low_err_source", "ca_star_high_err_source", "ca_h_err_source", "bending_modulus", "level_answers"};
+                 "ca_star_low_err_source", "ca_star_high_err_source", "ca_h_err_source", "bending_modulus", "level_answers",
+                 "ca_star_low_err_lacks", "ca_star_high_err_lacks", "ca_h_err_lacks"};
     t.json_columns = {"level_answers"};  // {"ca_h": {"2": 0.23, "4": 0.61}, ...}: nested in JSON output
     auto text_or_null = [](const std::string& x) { return x.empty() ? SqlValue{nullptr} : SqlValue{x}; };
     for (const auto& r : rows)
@@ -105,14 +107,18 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
                         value_of(r.ca_star_low_err), value_of(r.ca_star_high_err), value_of(r.ca_h_err),
                         std::int64_t{r.mesh_level}, text_or_null(r.error_levels), text_or_null(r.ca_star_low_err_source),
                         text_or_null(r.ca_star_high_err_source), text_or_null(r.ca_h_err_source),
-                        bending_modulus_of(r.group_key), text_or_null(campaign::level_answers_json(r.level_answers))});
+                        bending_modulus_of(r.group_key), text_or_null(campaign::level_answers_json(r.level_answers)),
+                        text_or_null(r.ca_star_low_err_lacks), text_or_null(r.ca_star_high_err_lacks),
+                        text_or_null(r.ca_h_err_lacks)});
     std::printf("%s", campaign::render(t, fmt).c_str());
     return 0;
   }
   // Markdown laid out like the seed's Table 1: one column per a/b, a Ca* line and a CaH line per law. With an
   // error estimate (analysis/uncertainty.h) an answer prints "x ± e", x to the digit of e. Without one, the
   // Ca* edges are sampled values (printed as sampled) and CaH, interpolated in its bracket, is rounded to the
-  // leading digit of the bracket width (a lower bound of its error: the mesh error is not known).
+  // leading digit of the bracket width (a lower bound of its error: the mesh error is not known). An error
+  // that lacks a part (no data: one level, no dt check) is a lower bound too: its ± is marked "†" and a legend
+  // under the table names the missing parts.
   std::vector<double> ars;
   std::vector<std::pair<std::string, double>> laws;
   for (const auto& r : rows) {
@@ -121,6 +127,7 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
     if (std::find(laws.begin(), laws.end(), l) == laws.end()) laws.push_back(l);
   }
   std::sort(ars.begin(), ars.end());
+  std::set<std::string> lacking;  // the missing-part lists of the errors marked †
   std::string out = "| |";
   for (double a : ars) out += " a/b = " + campaign::canonical_double(a) + " |";
   out += "\n|---|";
@@ -137,20 +144,40 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
         h += " |";
         continue;
       }
-      // An edge with an error estimate prints "x ± e" (digits of the error); without one, as sampled.
-      auto edge = [](const std::optional<double>& x, const std::optional<double>& e) {
-        return e ? campaign::format_plus_minus(*x, *e) : campaign::format_sampled(*x);
+      // An answer with an error estimate prints "x ± e" (digits of the error), "x ± e†" when e lacks a part;
+      // an edge without one prints as sampled.
+      auto with_error = [&](double x, double e, const std::string& lacks) {
+        if (lacks.empty()) return campaign::format_plus_minus(x, e);
+        lacking.insert(lacks);
+        return campaign::format_plus_minus(x, e) + "†";
       };
-      star += r->ca_star_low && r->ca_star_high ? " Ca* ∈ [" + edge(r->ca_star_low, r->ca_star_low_err) + ", " +
-                                                      edge(r->ca_star_high, r->ca_star_high_err) + "] |"
-              : campaign::is_sphere(*r)           ? " ⋆ (a sphere does not tumble) |"
-                                                  : " Ca* not found |";
+      auto edge = [&](const std::optional<double>& x, const std::optional<double>& e, const std::string& lacks) {
+        return e ? with_error(*x, *e, lacks) : campaign::format_sampled(*x);
+      };
+      star += r->ca_star_low && r->ca_star_high
+                  ? " Ca* ∈ [" + edge(r->ca_star_low, r->ca_star_low_err, r->ca_star_low_err_lacks) + ", " +
+                        edge(r->ca_star_high, r->ca_star_high_err, r->ca_star_high_err_lacks) + "] |"
+              : campaign::is_sphere(*r) ? " ⋆ (a sphere does not tumble) |"
+                                        : " Ca* not found |";
       h += r->ca_h && r->ca_h_low && r->ca_h_high
-               ? " CaH = " + (r->ca_h_err ? campaign::format_plus_minus(*r->ca_h, *r->ca_h_err)
+               ? " CaH = " + (r->ca_h_err ? with_error(*r->ca_h, *r->ca_h_err, r->ca_h_err_lacks)
                                           : campaign::format_with_error(*r->ca_h, *r->ca_h_high - *r->ca_h_low)) + " |"
                : " CaH not bracketed |";
     }
     out += star + "\n" + h + "\n";
+  }
+  if (!lacking.empty()) {
+    // The union of the missing parts, in the order of AnswerError::lacks, each with why it has no data.
+    std::string parts;
+    for (const auto& [part, why] : {std::pair{"mesh", "no other mesh level"}, std::pair{"periods", "period spread not recorded"},
+                                    std::pair{"dt", "no dt/2 check"}}) {
+      const bool any = std::any_of(lacking.begin(), lacking.end(), [&](const std::string& l) {
+        return ("," + l + ",").find(std::string(",") + part + ",") != std::string::npos;
+      });
+      if (any) parts += (parts.empty() ? "" : ", ") + std::string(part) + ": " + why;
+    }
+    out += "\n† a lower bound: this error lacks a part that had no data (" + parts +
+           "); the JSON's *_err_lacks name them per answer.\n";
   }
   // A membrane with bending stiffness is not the seed's: say so above the table (one value per campaign here,
   // as two would be two groups per cell, refused above).

@@ -503,8 +503,9 @@ void Store::save_transitions(std::int64_t campaign_id, const std::vector<Transit
                            "d12_threshold,n_samples,ca_star_low,ca_star_high,ca_star_below,ca_star_above,ca_min_d12,"
                            "ca_h,ca_h_low,ca_h_high,ca_h_low_case,ca_h_high_case,method,note,role,ca_star_low_err,"
                            "ca_star_high_err,ca_h_err,ca_star_low_err_source,ca_star_high_err_source,ca_h_err_source,"
-                           "error_levels,error_note,level_answers,updated_at) "
-                           "VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,") + kNow + ")");
+                           "error_levels,error_note,level_answers,ca_star_low_err_lacks,ca_star_high_err_lacks,"
+                           "ca_h_err_lacks,updated_at) "
+                           "VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,") + kNow + ")");
   auto opt_text = [](const std::string& x) { return x.empty() ? SqlValue{nullptr} : SqlValue{x}; };
   for (const auto& r : rows) {
     s.reset();
@@ -518,6 +519,8 @@ void Store::save_transitions(std::int64_t campaign_id, const std::vector<Transit
     s.bind(26, opt_text(r.ca_star_high_err_source)).bind(27, opt_text(r.ca_h_err_source));
     s.bind(28, opt_text(r.error_levels)).bind(29, r.error_note);
     s.bind(30, opt_text(level_answers_json(r.level_answers)));
+    s.bind(31, opt_text(r.ca_star_low_err_lacks)).bind(32, opt_text(r.ca_star_high_err_lacks));
+    s.bind(33, opt_text(r.ca_h_err_lacks));
     s.step();
   }
   t.commit();
@@ -542,6 +545,7 @@ std::vector<Transition> Store::transitions(std::int64_t campaign_id, int mesh_le
   const bool grouped = has_column(*db_, "transitions", "group_key");
   const bool with_errors = has_column(*db_, "transitions", "role");  // schema 4
   const bool with_level_answers = has_column(*db_, "transitions", "level_answers");  // schema 5
+  const bool with_lacks = has_column(*db_, "transitions", "ca_h_err_lacks");           // schema 6
   Stmt s(*db_, std::string("SELECT ") + (grouped ? "group_key" : "''") +
                    ", law, aspect_ratio, skalak_C, mesh_level, d12_threshold, n_samples, ca_star_low, ca_star_high, "
                    "ca_star_below, ca_star_above, ca_min_d12, ca_h, ca_h_low, ca_h_high, coalesce(ca_h_low_case,''), "
@@ -551,6 +555,9 @@ std::vector<Transition> Store::transitions(std::int64_t campaign_id, int mesh_le
                                   "coalesce(error_levels,''), error_note"
                                 : "'answer', NULL, NULL, NULL, '', '', '', '', ''") +
                    (with_level_answers ? ", coalesce(level_answers,'')" : ", ''") +
+                   (with_lacks ? ", coalesce(ca_star_low_err_lacks,''), coalesce(ca_star_high_err_lacks,''), "
+                                 "coalesce(ca_h_err_lacks,'')"
+                               : ", '', '', ''") +
                    " FROM transitions WHERE campaign_id=?1 "
                    "AND (?2 < 0 OR mesh_level = ?2) AND (?3 < -0.5 OR skalak_C = ?3 OR law='neo-hookean') "
                    "ORDER BY law, aspect_ratio, mesh_level DESC, 1");
@@ -587,6 +594,9 @@ std::vector<Transition> Store::transitions(std::int64_t campaign_id, int mesh_le
     t.error_levels = s.text(26);
     t.error_note = s.text(27);
     t.level_answers = level_answers_from_json(s.text(28));
+    t.ca_star_low_err_lacks = s.text(29);
+    t.ca_star_high_err_lacks = s.text(30);
+    t.ca_h_err_lacks = s.text(31);
     out.push_back(std::move(t));
   }
   return out;

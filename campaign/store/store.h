@@ -90,8 +90,9 @@ class Store {
  public:
   /// @brief Opens for writing, creating the file and schema if needed (one transaction, before any
   /// worker). A database of an older schema version this build can migrate (1 -> 2: adds the Slurm
-  /// tables; 2 -> 3: transitions keyed by group; 3 -> 4: role and error columns of transitions) is migrated in one
-  /// transaction; a newer or unknown version is refused.
+  /// tables; 2 -> 3: transitions keyed by group; 3 -> 4: role and error columns of transitions; 4 -> 5: level
+  /// answers; 5 -> 6: the missing parts of each error) is migrated in one transaction; a newer or unknown version
+  /// is refused.
   /// @throws BadInput for a corrupt/foreign file or a version it cannot read (nothing written).
   static std::unique_ptr<Store> open_for_write(const std::string& path);
   /// @brief Opens an existing database read-only (queries, status, dry runs). An older version that

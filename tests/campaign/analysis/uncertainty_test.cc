@@ -203,6 +203,28 @@ TEST(Uncertainty, TheLargestPartIsCarriedAndNamed) {
   ASSERT_TRUE(t.ca_h_err);
   EXPECT_NEAR(*t.ca_h_err, 0.015, 1e-12);
   EXPECT_EQ(t.ca_h_err_source, "periods");
+  // No dt check ran: the error is a lower bound, and says which part it lacks.
+  EXPECT_EQ(t.ca_h_err_lacks, "dt");
+}
+
+TEST(Uncertainty, AnErrorNamesThePartsItLacks) {
+  // Level 3 alone, periods recorded: CaH carries the period spread and lacks the mesh and dt parts.
+  auto tau = [](double ca) { return 2 * (0.5 - ca); };
+  std::vector<CaseSample> one;
+  add(one, {.level = 3, .ca = {0.4, 0.5, 0.52, 0.6}, .tau = tau, .tau_spread = 0.03});
+  const auto a = analyse(one, {2, 3});
+  ASSERT_TRUE(a.at(3).ca_h_err);
+  EXPECT_EQ(a.at(3).ca_h_err_lacks, "mesh,dt");
+  // With a coarser level and a dt/2 re-run at a bracketing case as well, nothing is missing.
+  std::vector<CaseSample> all = one;
+  add(all, {.level = 2, .ca = {0.4, 0.6}, .tau = [](double ca) { return 2 * (0.505 - ca); }});
+  add(all, {.level = 3, .dt = 0.01, .ca = {0.5}, .tau = tau, .tau_spread = 0.03});
+  const auto b = analyse(all, {2, 3});
+  ASSERT_TRUE(b.at(3).ca_h_err);
+  EXPECT_EQ(b.at(3).ca_h_err_lacks, "") << b.at(3).error_note;
+  // No answer, no error: nothing to lack either.
+  EXPECT_FALSE(b.at(3).ca_star_low_err);
+  EXPECT_EQ(b.at(3).ca_star_low_err_lacks, "");
 }
 
 TEST(Uncertainty, HalfTheStepGivesTheSecondOrderTimeError) {
@@ -299,6 +321,8 @@ TEST(Uncertainty, WithoutAnyPartTheCaHErrorIsUnknownAndAnEdgeKeepsItsGap) {
   EXPECT_NEAR(*t.ca_star_low_err, 0.05, 1e-12);
   EXPECT_EQ(t.ca_star_low_err_source, "bracket");
   EXPECT_NE(t.error_note.find("mesh: no data"), std::string::npos) << t.error_note;
+  EXPECT_EQ(t.ca_star_low_err_lacks, "mesh,periods,dt");
+  EXPECT_EQ(t.ca_h_err_lacks, "") << "an unknown error lacks nothing: it is not printed as a bound";
 }
 
 }  // namespace

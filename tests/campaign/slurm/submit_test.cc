@@ -7,6 +7,7 @@
 #include <regex>
 
 #include "campaign/slurm/slurm.h"
+#include "campaign/store/store.h"
 #include "tests/campaign/test_util.h"
 
 namespace capsim::campaign::testing {
@@ -330,16 +331,17 @@ TEST(SlurmSubmit, SchemaVersion1IsReadAsIsAndMigratedByAWriter) {
   FakeSlurm f(dir);
   r = sh(f.env() + exe() + " campaign collect --db " + db);
   EXPECT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(sql(db, "PRAGMA user_version"), "5\n");
+  EXPECT_EQ(sql(db, "PRAGMA user_version"), std::to_string(Store::expected_schema_version()) + "\n");
   EXPECT_EQ(sql(db, "SELECT count(*) FROM slurm_jobs"), "0\n");
   EXPECT_EQ(sql(db, "SELECT value FROM meta WHERE key='migrated_from'"), "1\n");
   EXPECT_EQ(sql(db, "SELECT * FROM results ORDER BY 1"), results);
   EXPECT_EQ(sql(db, "PRAGMA integrity_check"), "ok\n");
   // A newer version is refused.
-  r = sh("sqlite3 " + db + " 'PRAGMA user_version = 6;'");
+  const std::string newer = std::to_string(Store::expected_schema_version() + 1);
+  r = sh("sqlite3 " + db + " 'PRAGMA user_version = " + newer + ";'");
   r = sh(f.env() + exe() + " campaign collect --db " + db);
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("schema version 6"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("schema version " + newer), std::string::npos) << r.err;
 }
 
 }  // namespace

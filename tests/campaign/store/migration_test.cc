@@ -1,4 +1,4 @@
-// Schema 2 -> 3 (transitions keyed by group; 4 and 5 add columns): a committed version-2 database is read as it is, and a writer
+// Schema 2 -> 3 (transitions keyed by group; 4, 5 and 6 add columns): a committed version-2 database is read as it is, and a writer
 // migrates it in one transaction without changing what `capsim query table1` gives.
 #include <gtest/gtest.h>
 
@@ -27,12 +27,16 @@ TEST(Migration, Version2DatabaseMigratesToGroupKeysAndKeepsTable1) {
   // A writer (collect: no Slurm job, nothing to ingest) migrates.
   auto r = sh("env PATH=/usr/bin:/bin " + exe() + " campaign collect --db " + db);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(sql(db, "PRAGMA user_version"), "5\n");
+  EXPECT_EQ(sql(db, "PRAGMA user_version"), std::to_string(Store::expected_schema_version()) + "\n");
   EXPECT_EQ(sql(db, "SELECT value FROM meta WHERE key='migrated_from'"), "2\n");
   // Version 4 adds the role and error columns in place: migrated rows answer, without errors yet.
   EXPECT_EQ(sql(db, "SELECT count(*) FROM transitions WHERE role='answer' AND ca_h_err IS NULL"), rows_before);
   // Version 5 adds the level values (level_answers) in place: none until the campaign is analysed again.
   EXPECT_EQ(sql(db, "SELECT count(*) FROM transitions WHERE level_answers IS NULL"), rows_before);
+  // Version 6 adds the missing parts of each error in place: none known until analysed again.
+  EXPECT_EQ(sql(db, "SELECT count(*) FROM transitions WHERE ca_h_err_lacks IS NULL AND ca_star_low_err_lacks IS NULL "
+                    "AND ca_star_high_err_lacks IS NULL"),
+            rows_before);
   EXPECT_EQ(sql(db, "SELECT count(*) FROM transitions"), rows_before);
   // Every migrated row has a distinct group key naming its law, a/b and level.
   EXPECT_EQ(sql(db, "SELECT count(DISTINCT group_key) FROM transitions"), rows_before);

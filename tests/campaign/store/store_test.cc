@@ -33,7 +33,7 @@ std::string make_db(const std::string& dir) {
 }
 
 TEST(Store, SchemaVersionComesFromTheEmbeddedDdl) {
-  EXPECT_EQ(Store::expected_schema_version(), 5);
+  EXPECT_EQ(Store::expected_schema_version(), 6);  // schemas/006_error_lacks_v6.sql
   EXPECT_NE(std::string(kSchemaSql).find("CREATE TABLE IF NOT EXISTS transitions"), std::string::npos);
 }
 
@@ -49,7 +49,7 @@ TEST(Store, CreatesSchemaOnceWithWal) {
   sqlite3_finalize(st);
   sqlite3_close(h);
   auto r = sh(exe() + " query sql \"PRAGMA user_version; PRAGMA integrity_check\" --db " + db + " --format csv");
-  EXPECT_NE(r.out.find("5\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(std::to_string(Store::expected_schema_version()) + "\n"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("ok"), std::string::npos) << r.out;
 }
 

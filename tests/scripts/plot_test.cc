@@ -205,6 +205,23 @@ TEST_F(ScriptsTest, Table1FromTheDatabaseComparesCellByCell) {
   EXPECT_NE(t.find("seed 2.5 "), std::string::npos) << t;  // with the digits the seed printed
 }
 
+// A sphere whose max τmin is negative at every sampled Ca (the NH sphere with κ_b = 1e-2, results/bending/README.md
+// §6) has no CaH below its samples: it is compressed below CaL as well. The cell says so instead of "< Ca".
+TEST_F(ScriptsTest, Table1DoesNotBoundTheCaHOfAnAllCompressedSphere) {
+  const auto db = dir_ / "sphere.sqlite";
+  fs::copy_file(dir_ / "fixture.sqlite", db, fs::copy_options::overwrite_existing);
+  const Cmd ins = sh("sqlite3 " + q(db) +
+                     " \"INSERT INTO transitions(campaign_id, law, aspect_ratio, skalak_C, mesh_level, d12_threshold, "
+                     "n_samples, ca_h_high, method, note, updated_at) VALUES (1, 'neo-hookean', 1.0, -1.0, 1, 0.05, 3, "
+                     "0.267, 'grid', 'max_tau_min < 0 at the smallest sampled Ca', '2026-01-01T00:00:00Z')\"");
+  if (ins.code != 0) GTEST_SKIP() << "sqlite3 command-line tool not available";
+  const Cmd r = sh(table1() + " --db " + q(db));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("| none ≥ 0 · seed 0.63 <sup>"), std::string::npos) << r.out;  // missing, not ✗
+  EXPECT_NE(r.out.find("no tension window [CaL, CaH] found"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("< 0.27"), std::string::npos) << r.out;
+}
+
 TEST_F(ScriptsTest, Table1FromCapsimQueryJson) {
   const auto js = dir_ / "table1.json";
   const Cmd j = sh(std::string(CAPSIM_EXE_PATH) + " query table1 --db " + q(dir_ / "fixture.sqlite") +

@@ -339,9 +339,13 @@ AnswerError edge_error(const std::optional<double>& inside, const std::optional<
 }  // namespace
 
 std::string AnswerError::lacks() const {
+  const std::optional<double>* parts[] = {&mesh, &periods, &dt};  // in the order of kErrorParts
   std::string out;
-  for (const auto& [part, name] : {std::pair{&mesh, "mesh"}, std::pair{&periods, "periods"}, std::pair{&dt, "dt"}})
-    if (!*part) out += (out.empty() ? "" : ",") + std::string(name);
+  for (std::size_t i = 0; i < std::size(parts); ++i)
+    if (!*parts[i]) {
+      if (!out.empty()) out += ',';
+      out += kErrorParts[i];
+    }
   return out;
 }
 

@@ -66,6 +66,9 @@ struct ErrorOptions {
   std::vector<int> levels;
 };
 
+/// @brief The names of an error's numerical parts, in the order AnswerError::lacks lists them.
+inline constexpr const char* kErrorParts[] = {"mesh", "periods", "dt"};
+
 /// @brief One answer's error, split into its parts (in Ca; nullopt: no data for that part).
 struct AnswerError {
   std::optional<double> total;                    ///< what is reported (nullopt: unknown)

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "campaign/cli/commands.h"
+#include "campaign/analysis/uncertainty.h"
 #include "campaign/common/bad_input.h"
 #include "campaign/grid/decimal.h"
 #include "campaign/grid/precision.h"
@@ -127,7 +128,7 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
     if (std::find(laws.begin(), laws.end(), l) == laws.end()) laws.push_back(l);
   }
   std::sort(ars.begin(), ars.end());
-  std::set<std::string> lacking;  // the missing-part lists of the errors marked †
+  std::set<std::string> lacking;  // the missing parts of the errors marked † (analysis/uncertainty.h kErrorParts)
   std::string out = "| |";
   for (double a : ars) out += " a/b = " + campaign::canonical_double(a) + " |";
   out += "\n|---|";
@@ -148,7 +149,10 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
       // an edge without one prints as sampled.
       auto with_error = [&](double x, double e, const std::string& lacks) {
         if (lacks.empty()) return campaign::format_plus_minus(x, e);
-        lacking.insert(lacks);
+        for (std::size_t a = 0, b; a <= lacks.size(); a = b + 1) {  // split "mesh,dt" into its parts
+          b = std::min(lacks.find(',', a), lacks.size());
+          lacking.insert(lacks.substr(a, b - a));
+        }
         return campaign::format_plus_minus(x, e) + "†";
       };
       auto edge = [&](const std::optional<double>& x, const std::optional<double>& e, const std::string& lacks) {
@@ -167,15 +171,12 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
     out += star + "\n" + h + "\n";
   }
   if (!lacking.empty()) {
-    // The union of the missing parts, in the order of AnswerError::lacks, each with why it has no data.
+    // The union of the missing parts in the order of kErrorParts, each with why it has no data.
+    const char* why[] = {"no other mesh level", "period spread not recorded", "no dt/2 check"};
     std::string parts;
-    for (const auto& [part, why] : {std::pair{"mesh", "no other mesh level"}, std::pair{"periods", "period spread not recorded"},
-                                    std::pair{"dt", "no dt/2 check"}}) {
-      const bool any = std::any_of(lacking.begin(), lacking.end(), [&](const std::string& l) {
-        return ("," + l + ",").find(std::string(",") + part + ",") != std::string::npos;
-      });
-      if (any) parts += (parts.empty() ? "" : ", ") + std::string(part) + ": " + why;
-    }
+    for (std::size_t i = 0; i < std::size(campaign::kErrorParts); ++i)
+      if (lacking.count(campaign::kErrorParts[i]))
+        parts += (parts.empty() ? "" : ", ") + std::string(campaign::kErrorParts[i]) + ": " + why[i];
     out += "\n† a lower bound: this error lacks a part that had no data (" + parts +
            "); the JSON's *_err_lacks name them per answer.\n";
   }

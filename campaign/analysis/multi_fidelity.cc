@@ -57,6 +57,19 @@ std::vector<std::optional<double>> bracketing_ca(const Transition& t) {
 // samples: the rule of the answer level's bracketing of the minimum and of the scan's seeding of it.
 bool minimum_near_threshold(double min_d12, double threshold) { return min_d12 < 3 * threshold; }
 
+// The smallest sampled Ca when max τmin < 0 at every sample that has it (nullopt otherwise, or with none).
+// analyse_group turns that into a CaH bound for a spheroid only (a sphere is compressed below a CaL as well),
+// so the rounds read the samples themselves and treat both shapes alike.
+std::optional<double> smallest_if_all_compressed(const std::vector<Sample>& samples) {
+  std::optional<double> smallest;
+  for (const auto& s : samples)
+    if (s.max_tau_min) {
+      if (*s.max_tau_min >= 0) return std::nullopt;
+      if (!smallest || s.ca < *smallest) smallest = s.ca;
+    }
+  return smallest;
+}
+
 std::vector<double> sampled_ca(const SampleGroup& g) {
   std::vector<double> ca;
   for (const auto& s : g.samples) ca.push_back(s.ca);
@@ -83,6 +96,7 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
     // Seed: the scan's brackets.
     const Transition ts = analyse_group(scan.key, scan.samples, o.d12_threshold);
     for (const auto& x : bracketing_ca(ts)) p.add(x);
+    p.add(smallest_if_all_compressed(scan.samples));  // a spheroid's ca_h_high; a sphere has no such bound
     if (!ts.ca_star_low && ts.ca_min_d12) {
       p.add(ts.ca_min_d12);
       // No band on the scan level, but a minimum near the threshold (< 3×, as the refinement's bracketing):
@@ -116,7 +130,7 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
         return beyond ? std::optional<double>(quantise_ca(x / 1.5, o.ca_tolerance)) : std::nullopt;
       };
       if (ta.ca_h_low && !ta.ca_h_high) p.add(above(*ta.ca_h_low, true));
-      if (ta.ca_h_high && !ta.ca_h_low) {
+      if (const auto smallest_compressed = smallest_if_all_compressed(answer->samples)) {
         // max τmin < 0 at every answer-level sample is ambiguous: a membrane is compressed both above CaH
         // and below a lower critical number CaL (Lac et al. 2004; the NH sphere on level 3: τ < 0 at 0.4,
         // > 0 at 0.5, < 0 again above 0.62). So probe both ways: below the smallest sample, and the next
@@ -125,10 +139,10 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
         // τmin may tend to 0 from below with no window of τ > 0 at all (the NH sphere with κ_b = 1e-2:
         // −0.022 at Ca 0.01, −0.14 at 0.12, −0.02 at 0.6; walking down by ÷1.5 spent 12 cases finding
         // nothing). Past that step the answer is "max τmin < 0 at every sampled Ca".
-        const double smallest = *ta.ca_h_high;
+        const double smallest = *smallest_compressed;
         if (!scan_ca.empty() && (smallest > scan_ca.front() || same_ca(smallest, scan_ca.front())))
           p.add(below(smallest, true));  // the next scan Ca below, or one step below the scan's range
-        double largest = *ta.ca_h_high;
+        double largest = smallest;
         for (const auto& s : answer->samples)
           if (s.max_tau_min) largest = std::max(largest, s.ca);
         p.add(above(largest, false));

@@ -66,7 +66,15 @@ Transition analyse_group(Transition t, std::vector<Sample> samples, double thr) 
     int last_pos = -1;
     for (int i = 0; i < static_cast<int>(tau.size()); ++i)
       if (*tau[i]->max_tau_min >= 0) last_pos = i;
-    if (last_pos < 0) {
+    if (last_pos < 0 && is_sphere(t)) {
+      // A sphere is compressed below a lower critical number CaL as well as above CaH (Lac et al. 2004;
+      // results/bending/README.md §6), so compression at the smallest sample bounds no CaH: the tension window
+      // [CaL, CaH] may lie between two samples, or be gone (the NH sphere with kappa_b = 1e-2).
+      notes.push_back("max_tau_min < 0 at every sampled Ca (" + format_sampled(tau.front()->ca) + " to " +
+                      format_sampled(tau.back()->ca) +
+                      "): no tension window [CaL, CaH] sampled, and a sphere is compressed below CaL too, so no bound "
+                      "on CaH");
+    } else if (last_pos < 0) {
       notes.push_back("max_tau_min < 0 at every sampled Ca: CaH below " + format_sampled(tau.front()->ca));
       t.ca_h_high = tau.front()->ca;
       t.ca_h_high_case = tau.front()->case_id;

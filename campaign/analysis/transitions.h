@@ -106,6 +106,9 @@ std::string group_difference(const std::string& group_key_a, const std::string& 
 std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases);
 
 /// @brief Computes the transition row of one group from its samples (any order; status done only).
+/// CaH with max tau_min < 0 at every sample: for a spheroid, ca_h_high bounds it (CaH below the smallest
+/// sample); for a sphere nothing does (it is compressed below a CaL as well), so both bounds stay empty and
+/// the note says why.
 Transition analyse_group(Transition key, std::vector<Sample> samples, double d12_threshold);
 
 /// @brief analyse_group of every group, with @p method recorded.

@@ -32,6 +32,12 @@ CaseSample fake(int level, double ca, const std::function<double(double)>& tau, 
   return c;
 }
 
+// The same case on a sphere (a/b = 1): analyse_group gives an all-compressed sphere no CaH bound.
+CaseSample sphere(CaseSample c) {
+  c.params.set("capsule.aspect_ratio", 1.0);
+  return c;
+}
+
 std::vector<double> ca_at(const std::vector<CaseParams>& cases, int level) {
   std::vector<double> out;
   for (const auto& p : cases) {
@@ -99,15 +105,15 @@ TEST(MultiFidelity, AllCompressedOnTheAnswerLevelProbesBothWays) {
   const auto tau_sphere = [](double ca) { return (ca - 0.42) * (0.62 - ca); };
   const auto tau_coarse = [](double) { return -0.01; };
   std::vector<CaseSample> cases;
-  for (double ca : {0.4, 0.6, 0.8}) cases.push_back(fake(2, ca, tau_coarse));
-  cases.push_back(fake(3, 0.4, tau_sphere));
+  for (double ca : {0.4, 0.6, 0.8}) cases.push_back(sphere(fake(2, ca, tau_coarse)));
+  cases.push_back(sphere(fake(3, 0.4, tau_sphere)));
   auto add = answer_level_round(group_cases(cases), kOptions, 100);
   const auto proposed = ca_at(add, 3);
   EXPECT_TRUE(std::find(proposed.begin(), proposed.end(), 0.6) != proposed.end()) << "the next scan Ca above";
   // With 0.6 (τ > 0) and 0.8 (τ < 0) in, CaH is bracketed by the upper crossing and bisected there.
-  for (double ca : proposed) cases.push_back(fake(3, ca, tau_sphere));
+  for (double ca : proposed) cases.push_back(sphere(fake(3, ca, tau_sphere)));
   add = answer_level_round(group_cases(cases), kOptions, 100);
-  cases.push_back(fake(3, 0.8, tau_sphere));
+  cases.push_back(sphere(fake(3, 0.8, tau_sphere)));
   add = answer_level_round(group_cases(cases), kOptions, 100);
   for (double ca : ca_at(add, 3)) {
     EXPECT_GT(ca, 0.6);
@@ -120,12 +126,17 @@ TEST(MultiFidelity, AllCompressedProbesOneStepBelowTheScanAndStops) {
   // The NH sphere with κ_b = 1e-2: max τmin < 0 at every Ca, tending to 0 from below as Ca -> 0. The round
   // looks one step (÷1.5) below the scan's range and no further: walking down by ÷1.5 finds nothing.
   const auto tau = [](double ca) { return -0.1 * ca; };
+  const auto d12 = [](double ca) { return 1.0 - ca; };  // smallest at the largest Ca: it seeds 0.8 only
   std::vector<CaseSample> cases;
-  for (double ca : {0.4, 0.6, 0.8}) cases.push_back(fake(2, ca, tau));
-  for (double ca : {0.4, 0.6, 0.8}) cases.push_back(fake(3, ca, tau));
+  for (double ca : {0.4, 0.6, 0.8}) cases.push_back(sphere(fake(2, ca, tau, "done", 0, d12)));
+  // The scan alone: its smallest compressed Ca seeds the answer level (no CaH bound stands for it on a sphere).
   auto add = answer_level_round(group_cases(cases), kOptions, 100);
+  const auto seeded = ca_at(add, 3);
+  EXPECT_TRUE(std::find(seeded.begin(), seeded.end(), 0.4) != seeded.end());
+  for (double ca : {0.4, 0.6, 0.8}) cases.push_back(sphere(fake(3, ca, tau, "done", 0, d12)));
+  add = answer_level_round(group_cases(cases), kOptions, 100);
   EXPECT_EQ(ca_at(add, 3), (std::vector<double>{0.267}));
-  cases.push_back(fake(3, 0.267, tau));
+  cases.push_back(sphere(fake(3, 0.267, tau, "done", 0, d12)));
   add = answer_level_round(group_cases(cases), kOptions, 100);
   EXPECT_TRUE(add.empty()) << "already one step below the scan's smallest Ca 0.4: " << add.size() << " proposed";
 }

@@ -112,6 +112,34 @@ TEST(Transitions, ASphereHasNoCaStarAndNoMinimumToBracket) {
   EXPECT_DOUBLE_EQ(*t.ca_star_low, 0.005);
 }
 
+TEST(Transitions, AnAllCompressedSphereBoundsNoCaH) {
+  // max τmin < 0 at every sample. A spheroid: CaH lies below the smallest sample. A sphere is compressed below a
+  // CaL as well (the NH sphere with κ_b = 1e-2), so the same samples bound nothing and the note says why.
+  auto s = samples({0.1, 0.2, 0.4}, d12_oblate, [](double ca) { return -0.1 * ca; });
+  Transition key;
+  key.aspect_ratio = 2.0;
+  Transition t = analyse_group(key, s, 0.05);
+  ASSERT_TRUE(t.ca_h_high);
+  EXPECT_DOUBLE_EQ(*t.ca_h_high, 0.1);
+  EXPECT_NE(t.note.find("CaH below 0.1"), std::string::npos) << t.note;
+  key.aspect_ratio = 1.0;
+  t = analyse_group(key, s, 0.05);
+  EXPECT_FALSE(t.ca_h);
+  EXPECT_FALSE(t.ca_h_low);
+  EXPECT_FALSE(t.ca_h_high);
+  EXPECT_TRUE(t.ca_h_high_case.empty());
+  EXPECT_EQ(t.note.find("CaH below"), std::string::npos) << t.note;
+  EXPECT_NE(t.note.find("max_tau_min < 0 at every sampled Ca (0.1 to 0.4): no tension window [CaL, CaH] sampled"),
+            std::string::npos)
+      << t.note;
+  // One sample in tension brackets the upper crossing as for any shape.
+  s[1].max_tau_min = 0.05;
+  t = analyse_group(key, s, 0.05);
+  ASSERT_TRUE(t.ca_h);
+  EXPECT_DOUBLE_EQ(*t.ca_h_low, 0.2);
+  EXPECT_DOUBLE_EQ(*t.ca_h_high, 0.4);
+}
+
 TEST(Adaptive, ProposalsShrinkBracketsAndConverge) {
   // Start coarse, add the proposals of each round: the Ca* edges and CaH converge to the tolerance.
   std::vector<double> cas = {0.01, 0.1, 0.4, 0.8, 1.2};

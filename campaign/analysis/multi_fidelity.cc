@@ -70,6 +70,27 @@ std::optional<double> smallest_if_all_compressed(const std::vector<Sample>& samp
   return smallest;
 }
 
+// Whether the cell of `answer` has a dt check case on its level (any Ca, any status): phase 5 has run there.
+bool has_dt_check(const std::vector<SampleGroup>& groups, const std::vector<std::string>& roles,
+                  const SampleGroup& answer) {
+  const std::string cell = cell_key(answer.key.group_key);
+  for (std::size_t j = 0; j < groups.size(); ++j)
+    if (roles[j] == "dt_check" && groups[j].key.mesh_level == answer.key.mesh_level && !groups[j].case_ca.empty() &&
+        cell_key(groups[j].key.group_key) == cell)
+      return true;
+  return false;
+}
+
+// The answer-level sample phase 5 re-runs with dt/2: the CaH-low case, else the Ca*-low case (nullptr: neither,
+// or it has no recorded step).
+const Sample* dt_check_sample(const Transition& t, const SampleGroup& answer) {
+  const std::optional<double> ca = t.ca_h_low ? t.ca_h_low : t.ca_star_low;
+  if (!ca) return nullptr;
+  for (const auto& s : answer.samples)
+    if (same_ca(s.ca, *ca) && s.dt) return &s;
+  return nullptr;
+}
+
 std::vector<double> sampled_ca(const SampleGroup& g) {
   std::vector<double> ca;
   for (const auto& s : g.samples) ca.push_back(s.ca);
@@ -149,8 +170,10 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
       }
       if (ta.ca_star_low && !ta.ca_star_below) p.add(below(*ta.ca_star_low, false));
       if (ta.ca_star_high && !ta.ca_star_above) p.add(above(*ta.ca_star_high, false));
-      // Refine: bisect, each bracket down to max(ca_tolerance, its numerical error).
-      if (o.adaptive) {
+      // Refine: bisect, each bracket down to max(ca_tolerance, its numerical error) — with dt_check, once the
+      // cell's dt check exists (where phase 5 has a case to re-run), so that the error has its dt part.
+      const bool dt_pending = o.dt_check && !has_dt_check(groups, roles, *answer) && dt_check_sample(ta, *answer);
+      if (o.adaptive && !dt_pending) {
         const GroupErrors e = answer_errors(ta, groups, roles, ia);
         // The minimum of min D12 is searched only near the threshold (< 3×): a sphere's 0.45 has no band to find.
         double best = 1e300;
@@ -232,22 +255,10 @@ std::vector<CaseParams> dt_check_cases(const std::vector<SampleGroup>& groups, c
   for (std::size_t i = 0; i < groups.size() && budget > 0; ++i) {
     if (roles[i] != "answer" || groups[i].key.mesh_level != o.levels[1]) continue;
     const SampleGroup& answer = groups[i];
-    const Transition t = analyse_group(answer.key, answer.samples, o.d12_threshold);
-    const std::optional<double> ca = t.ca_h_low ? t.ca_h_low : t.ca_star_low;
-    if (!ca) continue;
-    const Sample* c = nullptr;
-    for (const auto& s : answer.samples)
-      if (same_ca(s.ca, *ca)) c = &s;
-    if (!c || !c->dt) continue;
-    bool exists = false;  // a dt_check case at this Ca in the cell already (any status)
-    const std::string cell = cell_key(answer.key.group_key);
-    for (std::size_t j = 0; j < groups.size(); ++j)
-      if (roles[j] == "dt_check" && groups[j].key.mesh_level == answer.key.mesh_level &&
-          cell_key(groups[j].key.group_key) == cell)
-        for (double x : groups[j].case_ca) exists = exists || same_ca(x, *ca);
-    if (exists) continue;
+    const Sample* c = dt_check_sample(analyse_group(answer.key, answer.samples, o.d12_threshold), answer);
+    if (!c || has_dt_check(groups, roles, answer)) continue;
     CaseParams p = answer.base;
-    p.set("flow.capillary_number", *ca);
+    p.set("flow.capillary_number", c->ca);
     p.set("time.dt", 0.5 * *c->dt);
     out.push_back(std::move(p));
     --budget;

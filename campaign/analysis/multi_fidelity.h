@@ -15,15 +15,20 @@
 /// 4. **refine** (adaptive mode): bisection on the answer level (analysis/refinement.h), each bracket
 ///    stopping once it is narrower than max(ca_tolerance, the answer's numerical error): refining a bracket
 ///    below what the mesh resolves buys nothing; without a Ca* band the minimum of min D12 is bracketed only
-///    while it is within 3× the threshold (a band may lie between samples; a sphere's 0.45 has none);
-/// 5. **dt check** (dt_check = true): the CaH-low case of each cell (else its Ca*-low case) on the answer
-///    level with time.dt = half the step it ran with;
+///    while it is within 3× the threshold (a band may lie between samples; a sphere's 0.45 has none). With
+///    dt_check = true a cell is refined only once its dt check exists (phase 5): until then its errors lack
+///    the dt part, and a bracket refined down to the rest alone may be refined below the time step's error
+///    (the κ_b = 1e-2 NH a/b = 2 CaH, whose only part was a period spread of 6e-5, was bisected to 0.013);
+/// 5. **dt check** (dt_check = true): once per cell, when phases 2–4 add nothing (with dt_check, before the
+///    cell is refined), the CaH-low case (else the Ca*-low case) on the answer level with time.dt = half the
+///    step it ran with; its dt part then serves every answer of the cell (analysis/uncertainty.h);
 /// 6. **check** (a third level): the final bracketing cases of every answer re-run on the check level,
 ///    which gives the mesh part of the error (analysis/uncertainty.h); where the check level's two values
 ///    lie on one side of the target (its answer is outside the answer level's bracket), the answer level's
 ///    next sample outwards too, one at a time, until the check level brackets its answer itself.
-/// Phases 2–4 repeat as rounds until none adds a case; 5 and 6 run once, after them (the cheap dt check
-/// first, so that a campaign interrupted among the check level's long cases has it).
+/// Phases 2–4 repeat as rounds until none adds a case; 5 runs when they add none, and they resume after it
+/// (the refinement); 6 runs last (the cheap dt check first, so that a campaign interrupted among the check
+/// level's long cases has it). The mesh part is not waited for: on a third level it costs hours.
 
 #include <vector>
 
@@ -39,6 +44,7 @@ struct MultiFidelityOptions {
   double d12_threshold = 0.05;
   double ca_tolerance = 0.005;  ///< smallest bracket adaptive mode makes
   bool adaptive = false;        ///< phase 4
+  bool dt_check = false;        ///< phase 5 will run: phase 4 waits for each cell's dt check
 };
 
 /// @brief Phases 2–4: the cases of one round on the answer level (none: the answer level is done). New cases
@@ -57,7 +63,7 @@ std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups
                                           int budget);
 
 /// @brief Phase 5: per cell, the CaH-low case of the answer level (else its Ca*-low case) with time.dt set
-/// to half the step it ran with; none where such a case exists already.
+/// to half the step it ran with; none in a cell that has a dt check case already (any Ca, any status).
 std::vector<CaseParams> dt_check_cases(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,
                                        int budget);
 

@@ -160,6 +160,53 @@ TEST(MultiFidelity, RefinementStopsAtTheNumericalError) {
   }
 }
 
+// With dt_check, a cell is refined only once its dt check exists: until then its error lacks the dt part, and
+// the rest alone may be far below it (the κ_b = 1e-2 NH a/b = 2 CaH, a period spread of 6e-5, was bisected to
+// 0.013). The dt check runs once per cell, at the CaH-low case of the time.
+TEST(MultiFidelity, RefinementWaitsForTheCellsDtCheck) {
+  for (double dt_shift : {0.1, 0.001}) {
+    std::vector<CaseSample> cases;
+    auto t2 = [](double ca) { return 0.601 - ca; };  // level 2 close to level 3: a mesh error of 0.001
+    for (double ca : {0.1, 0.2, 0.5, 1.0}) cases.push_back(fake(2, ca, t2));
+    for (double ca : {0.1, 0.2, 0.5, 0.55, 0.65, 1.0}) cases.push_back(fake(3, ca, tau3));
+    MultiFidelityOptions o = kOptions;
+    ASSERT_EQ(answer_level_round(group_cases(cases), o, 100).size(), 1u) << "without dt_check it refines now";
+    o.dt_check = true;
+    EXPECT_TRUE(answer_level_round(group_cases(cases), o, 100).empty()) << "waits for the dt check";
+    const auto dt = dt_check_cases(group_cases(cases), o, 100);
+    ASSERT_EQ(dt.size(), 1u);
+    EXPECT_DOUBLE_EQ(dt[0].capillary_number(), 0.55);
+    cases.push_back(fake(3, 0.55, [&](double ca) { return tau3(ca) + dt_shift; }, "done", 0.01));
+    const auto add = answer_level_round(group_cases(cases), o, 100);
+    if (dt_shift > 0.05) {
+      // dt part |Δτ| / (1 − 1/4) = 0.13 in τ, 0.13 in Ca at slope −1: wider than the bracket 0.1.
+      EXPECT_TRUE(add.empty()) << "bracket 0.1 < dt error 0.13: refining it buys nothing";
+    } else {
+      ASSERT_EQ(add.size(), 1u);
+      EXPECT_GT(add[0].capillary_number(), 0.55);
+      EXPECT_LT(add[0].capillary_number(), 0.65);
+      // The bracket moves (CaH-low 0.6 now); the cell keeps its one dt check.
+      cases.push_back(fake(3, 0.6, tau3));
+      EXPECT_TRUE(dt_check_cases(group_cases(cases), o, 100).empty()) << "one dt check per cell";
+    }
+  }
+  // A cell with nothing for the dt check to re-run (no CaH-low, no Ca*-low: only a minimum of min D12 near the
+  // threshold to bracket) does not wait for it.
+  const auto d12 = [](double ca) { return ca < 0.07 ? 0.2 : ca < 0.09 ? 0.072 : ca < 0.2 ? 0.074 : 0.36; };
+  const auto tension = [](double) { return -0.01; };  // compressed throughout: no CaH-low
+  std::vector<CaseSample> cases;
+  for (double ca : {0.06, 0.08, 0.1, 0.3}) {
+    cases.push_back(fake(2, ca, tension, "done", 0, d12));
+    cases.push_back(fake(3, ca, tension, "done", 0, d12));
+  }
+  MultiFidelityOptions o = kOptions;
+  o.dt_check = true;
+  EXPECT_TRUE(dt_check_cases(group_cases(cases), o, 100).empty());
+  const auto add = ca_at(answer_level_round(group_cases(cases), o, 100), 3);
+  EXPECT_TRUE(std::any_of(add.begin(), add.end(), [](double ca) { return ca > 0.08 && ca < 0.1; }))
+      << "the minimum's bracket (0.08, 0.1) is refined";
+}
+
 TEST(MultiFidelity, TheCheckLevelRunsTheFinalBrackets) {
   std::vector<CaseSample> cases;
   for (double ca : {0.1, 0.2, 0.5, 1.0}) cases.push_back(fake(2, ca, tau2));

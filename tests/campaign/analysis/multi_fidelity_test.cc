@@ -161,8 +161,7 @@ TEST(MultiFidelity, RefinementStopsAtTheNumericalError) {
 }
 
 // With dt_check, a cell is refined only once its dt check exists: until then its error lacks the dt part, and
-// the rest alone may be far below it (the κ_b = 1e-2 NH a/b = 2 CaH, a period spread of 6e-5, was bisected to
-// 0.013). The dt check runs once per cell, at the CaH-low case of the time.
+// the rest alone may be far below it. The dt check runs once per cell, at the CaH-low case of the time.
 TEST(MultiFidelity, RefinementWaitsForTheCellsDtCheck) {
   for (double dt_shift : {0.1, 0.001}) {
     std::vector<CaseSample> cases;

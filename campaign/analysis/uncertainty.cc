@@ -340,6 +340,7 @@ AnswerError edge_error(const std::optional<double>& inside, const std::optional<
 
 std::string AnswerError::lacks() const {
   const std::optional<double>* parts[] = {&mesh, &periods, &dt};  // in the order of kErrorParts
+  static_assert(std::size(parts) == std::size(kErrorParts), "one value per named part");
   std::string out;
   for (std::size_t i = 0; i < std::size(parts); ++i)
     if (!*parts[i]) {

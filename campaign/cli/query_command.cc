@@ -172,7 +172,8 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
   }
   if (!lacking.empty()) {
     // The union of the missing parts in the order of kErrorParts, each with why it has no data.
-    const char* why[] = {"no other mesh level", "period spread not recorded", "no dt/2 check"};
+    constexpr const char* why[] = {"no other mesh level", "period spread not recorded", "no dt/2 check"};
+    static_assert(std::size(why) == std::size(campaign::kErrorParts), "one reason per named part");
     std::string parts;
     for (std::size_t i = 0; i < std::size(campaign::kErrorParts); ++i)
       if (lacking.count(campaign::kErrorParts[i]))

@@ -127,25 +127,71 @@ std::optional<double> value_difference(const SampleGroup& g2, const SampleGroup&
   return out;
 }
 
+// The largest |q_L2(c) − q_L(c)| over the bracket Ca c ∈ {a, b}, with q_L2(c) interpolated linearly between
+// g2's nearest samples on either side of c (or taken at c): for a level sampled elsewhere (nullopt where g2's
+// samples do not span c).
+std::optional<double> interpolated_value_difference(const SampleGroup& g2, const SampleGroup& g, Quantity q, double a,
+                                                    double b) {
+  std::optional<double> out;
+  const auto coarse = with_value(g2, q);
+  for (const auto& s : g.samples) {
+    if (!(same_ca(s.ca, a) || same_ca(s.ca, b)) || !value(s, q)) continue;
+    const Sample *below = nullptr, *above = nullptr;
+    for (const Sample* c : coarse) {
+      if (c->ca <= s.ca || same_ca(c->ca, s.ca)) {
+        if (!below || c->ca > below->ca) below = c;
+      }
+      if (c->ca >= s.ca || same_ca(c->ca, s.ca)) {
+        if (!above || c->ca < above->ca) above = c;
+      }
+    }
+    if (!below || !above) continue;
+    double y2 = *value(*below, q);
+    if (!same_ca(below->ca, s.ca) && !same_ca(above->ca, below->ca))
+      y2 += (*value(*above, q) - y2) * (s.ca - below->ca) / (above->ca - below->ca);
+    const double d = std::fabs(y2 - *value(s, q));
+    if (!out || d > *out) out = d;
+  }
+  return out;
+}
+
 // The mesh part of an answer, directly in Ca: the answer level's own value `here` against the neighbouring
 // levels' answers (Richardson with three monotone levels, else the last difference). A neighbour whose line
 // through the bracket samples crosses the target more than a bracket width outside the bracket [a, b] (its
 // values do not straddle the target and the line is nearly flat: an oblate capsule whose coarse level has no
 // band there) says nothing about where level L's crossing is; it is compared as values instead: the largest
-// |Δq| at the bracket samples over |slope| (slope of q on level L), as the periods and dt parts are.
+// |Δq| at the bracket samples over |slope| (slope of q on level L), as the periods and dt parts are. So is a
+// neighbour with no answer there at all (a coarse scan level whose max τmin keeps one sign over its grid while
+// level L has a CaH: the NH prolate capsule at κ_b = 1e-2), with its q interpolated at the bracket Ca: without
+// it the error would lack its mesh part and bisection would refine the bracket far below what the levels'
+// disagreement allows (results/bending/README.md §8).
 Part mesh_part(const Cell& cell, int level, Answer which, double a, double b, double here, double thr, double slope,
                std::set<int>& levels_used) {
   const Quantity q = which == Answer::kCaH ? Quantity::kMaxTauMin : Quantity::kMinD12;
   const double lo = std::min(a, b), hi = std::max(a, b), width = hi - lo;
   auto far = [&](double x) { return x < lo - width || x > hi + width; };
-  std::optional<double> coarse, fine, far_e;
-  std::string far_how;
+  std::optional<double> coarse, fine, far_e, values_e;  // values_e: a neighbour with no answer, as values
+  std::string far_how, values_how;
+  int values_level = 0;
   std::set<int> far_level;
   auto take = [&](int l, std::optional<double>& out) {
     auto it = cell.by_level.find(l);
     if (it == cell.by_level.end()) return;
     const LevelCrossing c = level_answer(*it->second, which, a, b, thr, l > level ? cell.by_level.at(level) : nullptr);
     out = c.ca;
+    if (!out) {
+      const auto d = interpolated_value_difference(*it->second, *cell.by_level.at(level), q, a, b);
+      if (!d || !(std::fabs(slope) > 0) || !std::isfinite(slope)) return;
+      const double e = *d / std::fabs(slope);
+      if (!values_e || e > *values_e) {
+        values_e = e;
+        values_level = l;
+        values_how = "level " + std::to_string(l) + " has no " + (which == Answer::kCaH ? "CaH" : "band edge") +
+                     " here: its " + name_of(q) + ", interpolated at the bracket samples, differs by " + num(*d) +
+                     ", over |slope| " + num(std::fabs(slope));
+      }
+      return;
+    }
     // Only a crossing extrapolated from that level's own samples at a and b can be "far" (its own answer
     // from its own bracket, elsewhere or beyond, is a real mesh difference, however large).
     if (!out || !c.extrapolated || !far(*out)) return;
@@ -194,6 +240,12 @@ Part mesh_part(const Cell& cell, int level, Answer which, double a, double b, do
   if (far_e && (!p.e || *far_e > *p.e)) {
     p.e = far_e;
     p.how = far_how;
+  }
+  // Only where nothing else gives the mesh part: a finer level's answer is the better estimate.
+  if (!p.e && values_e) {
+    p.e = values_e;
+    p.how = values_how;
+    levels_used.insert(values_level);
   }
   return p;
 }
@@ -267,10 +319,18 @@ void to_ca(const Parts& parts, double slope, Quantity q, AnswerError& e) {
 // allowed) until it spans at least `span`.
 double secant(const std::vector<const Sample*>& s, std::size_t lo, std::size_t hi, double span, Quantity q,
               bool widen_lo, bool widen_hi, std::string& where) {
+  // Widen only while q keeps the bracket's trend: past an extremum (the top of a sphere's tension window, which
+  // closes again below CaL) a secant flattens and turns every error in q into a huge error in Ca.
+  const double trend = *value(*s[hi], q) - *value(*s[lo], q);
+  auto continues = [&](std::size_t inner, std::size_t outer, bool outwards_up) {
+    const double step = *value(*s[outer], q) - *value(*s[inner], q);
+    return (outwards_up ? step : -step) * trend >= 0;
+  };
   while (s[hi]->ca - s[lo]->ca < span) {
     bool moved = false;
-    if (widen_lo && lo > 0) --lo, moved = true;
-    if (s[hi]->ca - s[lo]->ca < span && widen_hi && hi + 1 < s.size()) ++hi, moved = true;
+    if (widen_lo && lo > 0 && continues(lo, lo - 1, false)) --lo, moved = true;
+    if (s[hi]->ca - s[lo]->ca < span && widen_hi && hi + 1 < s.size() && continues(hi, hi + 1, true))
+      ++hi, moved = true;
     if (!moved) break;
   }
   where = "[" + format_sampled(s[lo]->ca) + ", " + format_sampled(s[hi]->ca) + "]";

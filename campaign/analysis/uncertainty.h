@@ -25,7 +25,11 @@
 ///   two bracket Ca crosses the target more than a bracket width outside the bracket (no crossing there: the
 ///   oblate capsule with bending, whose level 2 has no band where level 3 has one) is compared as values
 ///   instead: max |Δq| at the two samples over |slope| of q on level L (as the periods and dt parts); its
-///   crossing is still recorded in AnswerError::on_level.
+///   crossing is still recorded in AnswerError::on_level. Where no neighbour has an answer near the bracket at
+///   all (a scan level whose max τmin keeps one sign over its grid, or with no band, and no finer level), the
+///   coarser one is compared as values, its q interpolated linearly at the two bracket Ca between its nearest
+///   samples on either side (the last difference of a two-level campaign again: an over-estimate where the
+///   mesh converges); only where its samples do not span the bracket does the mesh part stay missing.
 /// - **periods**: the spread of the quantity q (max τmin for CaH, min D12 for an edge) over the last periods
 ///   of the two bracketing cases (min_D12_period_spread, max_tau_min_period_spread of their results), the
 ///   larger of the two;
@@ -36,7 +40,9 @@
 /// answer level. The error of the answer is the largest part (named in the source):
 /// - **CaH** (zero of max τmin between Ca_a and Ca_b): e_Ca = max(mesh, periods/|s|, dt/|s|), s the secant of
 ///   max τmin over the bracket widened outwards (one sample each side at a time) until it spans 10 % of CaH,
-///   so that a bracket refined far below the noise of τmin does not give a meaningless slope.
+///   so that a bracket refined far below the noise of τmin does not give a meaningless slope; a side stops
+///   widening at a sample that breaks the bracket's trend (past the top of a sphere's tension window the
+///   secant would flatten).
 /// - **a Ca* edge** (the sampled Ca inside the band, the neighbour outside it): the edge lies between the
 ///   two samples, so it inherits the whole gap, plus the numerical part:
 ///   e_Ca = |Ca_in − Ca_out| + max(mesh, periods/|s|, dt/|s|), s the secant of min D12 from the inside sample

@@ -307,6 +307,59 @@ TEST(Uncertainty, ACoarseLevelCrossingFarOutsideTheBracketIsComparedAsValues) {
   EXPECT_NEAR(*b.at(3).ca_h_err, 0.62 - 0.35, 1e-12) << b.at(3).error_note;
 }
 
+// A coarse scan level with no CaH of its own (max τmin < 0 over its whole grid, as the NH prolate capsule at
+// κ_b = 1e-2 on level 2) is compared as values, interpolated at the bracket Ca: the CaH error gets a mesh part
+// instead of lacking it. Where the coarse samples do not span the bracket, the part stays missing.
+TEST(Uncertainty, ACoarseLevelWithNoAnswerIsComparedAsInterpolatedValues) {
+  std::vector<CaseSample> cases;
+  add(cases, {.level = 2, .ca = {0.2, 0.3, 0.4, 0.6}, .tau = [](double ca) { return -0.02 - 0.1 * ca; },
+              .tau_spread = 0.0});
+  add(cases, {.level = 3, .ca = {0.3, 0.33, 0.35, 0.4}, .tau = [](double ca) { return 0.338 - ca; },
+              .tau_spread = 0.0});
+  const auto a = analyse(cases, {2, 3});
+  const Transition& t = a.at(3);
+  ASSERT_TRUE(t.ca_h && t.ca_h_err) << t.error_note;
+  EXPECT_NEAR(*t.ca_h, 0.338, 1e-12);
+  // At the bracket Ca 0.33 and 0.35 level 2 has −0.053 and −0.055, level 3 +0.008 and −0.012; slope −1.
+  EXPECT_NEAR(*t.ca_h_err, 0.061, 1e-12) << t.error_note;
+  EXPECT_EQ(t.ca_h_err_source, "mesh");
+  EXPECT_EQ(t.ca_h_err_lacks, "dt") << t.error_note;
+  EXPECT_NE(t.error_note.find("level 2 has no CaH here"), std::string::npos) << t.error_note;
+
+  std::vector<CaseSample> short_scan;  // level 2 sampled only below the bracket: nothing to interpolate
+  add(short_scan, {.level = 2, .ca = {0.1, 0.2}, .tau = [](double ca) { return -0.02 - 0.1 * ca; },
+                   .tau_spread = 0.0});
+  add(short_scan, {.level = 3, .ca = {0.3, 0.33, 0.35, 0.4}, .tau = [](double ca) { return 0.338 - ca; },
+                   .tau_spread = 0.0});
+  const auto b = analyse(short_scan, {2, 3});
+  EXPECT_EQ(b.at(3).ca_h_err_lacks, "mesh,dt") << b.at(3).error_note;
+
+  // With a finer level at the brackets, its answer gives the mesh part; the coarse values are not used.
+  add(cases, {.level = 4, .ca = {0.33, 0.35}, .tau = [](double ca) { return 0.34 - ca; }, .tau_spread = 0.0});
+  const auto c = analyse(cases, {2, 3, 4});
+  ASSERT_TRUE(c.at(3).ca_h_err) << c.at(3).error_note;
+  EXPECT_NEAR(*c.at(3).ca_h_err, 0.002, 1e-12) << c.at(3).error_note;
+}
+
+// The secant that turns an error in max τmin into one in Ca is widened to span 10 % of CaH, but not past the
+// top of a tension window (a sphere: τ < 0 below CaL and above CaH; the NH sphere of results/table1_mf.sqlite
+// on level 3): through the window's far side the secant is nearly flat (0.0024 there) and the error in Ca
+// absurd. Here it widens outwards on the compressed side only.
+TEST(Uncertainty, TheCaHSecantDoesNotWidenAcrossTheTopOfATensionWindow) {
+  auto table = [](std::map<double, double> m) { return [m](double ca) { return m.at(ca); }; };
+  std::vector<CaseSample> cases;
+  add(cases, {.level = 3,
+              .ca = {0.267, 0.4, 0.6, 0.65, 0.8},
+              .tau = table({{0.267, -0.0664}, {0.4, -0.0068}, {0.6, 0.0035}, {0.65, -0.0062}, {0.8, -0.064}}),
+              .tau_spread = 0.0002});
+  const auto a = analyse(cases);
+  const Transition& t = a.at(3);
+  ASSERT_TRUE(t.ca_h && t.ca_h_err) << t.error_note;
+  const double slope = (-0.064 - 0.0035) / (0.8 - 0.6);
+  EXPECT_NEAR(*t.ca_h_err, 0.0002 / std::fabs(slope), 1e-12) << t.error_note;
+  EXPECT_NE(t.error_note.find("over Ca [0.6, 0.8]"), std::string::npos) << t.error_note;
+}
+
 TEST(Uncertainty, WithoutAnyPartTheCaHErrorIsUnknownAndAnEdgeKeepsItsGap) {
   std::vector<CaseSample> cases;
   add(cases, {.level = 3,

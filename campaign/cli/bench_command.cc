@@ -157,7 +157,7 @@ int bench_flow(const BenchArgs& ba) {
     const nlohmann::json j = {{"level", r.level},
                               {"nodes", sym.nodes},
                               {"threads", r.threads},
-                              {"isa", r.isa},
+                              {"kernel_isa", r.isa},
                               {"evaluation_ms", sym.evaluation_ms},
                               {"regular_sum_ms", sym.regular_sum_ms},
                               {"overhead_ratio", sym.overhead_ratio},
@@ -245,7 +245,7 @@ int bench_command(const std::vector<std::string>& args) {
                               {"plain_interactions_per_s", plain_rate},
                               {"max_rel_error", fast_err},
                               {"threads", nthreads},
-                              {"isa", sk::kernel_isa()}};
+                              {"kernel_isa", sk::kernel_isa()}};
     std::printf("%s\n", j.dump().c_str());
   }
   return fast_err <= 1e-12 ? 0 : 1;

@@ -160,11 +160,11 @@ std::optional<double> interpolated_value_difference(const SampleGroup& g2, const
 // through the bracket samples crosses the target more than a bracket width outside the bracket [a, b] (its
 // values do not straddle the target and the line is nearly flat: an oblate capsule whose coarse level has no
 // band there) says nothing about where level L's crossing is; it is compared as values instead: the largest
-// |Δq| at the bracket samples over |slope| (slope of q on level L), as the periods and dt parts are. So is a
-// neighbour with no answer there at all (a coarse scan level whose max τmin keeps one sign over its grid while
-// level L has a CaH: the NH prolate capsule at κ_b = 1e-2), with its q interpolated at the bracket Ca: without
-// it the error would lack its mesh part and bisection would refine the bracket far below what the levels'
-// disagreement allows (results/bending/README.md §8).
+// |Δq| at the bracket samples over |slope| (slope of q on level L), as the periods and dt parts are. Where no
+// neighbour gives anything else, one with no answer there at all (a coarse scan level whose max τmin keeps one
+// sign over its grid while level L has a CaH: the NH prolate capsule at κ_b = 1e-2) is compared as values too,
+// its q interpolated at the bracket Ca: without it the error would lack its mesh part and bisection would
+// refine the bracket far below what the levels' disagreement allows (results/bending/README.md §8).
 Part mesh_part(const Cell& cell, int level, Answer which, double a, double b, double here, double thr, double slope,
                std::set<int>& levels_used) {
   const Quantity q = which == Answer::kCaH ? Quantity::kMaxTauMin : Quantity::kMinD12;

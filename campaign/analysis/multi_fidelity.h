@@ -18,8 +18,8 @@
 ///    while it is within 3× the threshold (a band may lie between samples; a sphere's 0.45 has none). With
 ///    dt_check = true a cell is refined only once its dt check exists (phase 5): until then its errors lack
 ///    the dt part, and a bracket refined down to the rest alone may be refined below the time step's error.
-///    (It does not help where the missing part is the mesh one: the κ_b = 1e-2 NH a/b = 2 CaH, bisected to
-///    0.003 on a period spread of 6e-5, has a dt part of 2e-5 — level 2 brackets no CaH there.);
+///    (The mesh part needs no such wait: the scan level exists from the start, and where it has no answer of
+///    its own near a bracket it is compared as values, analysis/uncertainty.h.);
 /// 5. **dt check** (dt_check = true): once per cell, when phases 2–4 add nothing (with dt_check, before the
 ///    cell is refined), the CaH-low case (else the Ca*-low case) on the answer level with time.dt = half the
 ///    step it ran with; its dt part then serves every answer of the cell (analysis/uncertainty.h);

@@ -115,22 +115,10 @@ LevelCrossing level_answer(const SampleGroup& g2, Answer which, double a, double
   return {crossing(*in, *y_in, *out, *y_out, thr), false};
 }
 
-// The largest |q_L2(c) − q_L(c)| over the bracket Ca c ∈ {a, b} where both groups have q (nullopt: none).
-std::optional<double> value_difference(const SampleGroup& g2, const SampleGroup& g, Quantity q, double a, double b) {
-  std::optional<double> out;
-  for (const auto& s2 : g2.samples)
-    for (const auto& s : g.samples)
-      if (same_ca(s2.ca, s.ca) && (same_ca(s.ca, a) || same_ca(s.ca, b)) && value(s2, q) && value(s, q)) {
-        const double d = std::fabs(*value(s2, q) - *value(s, q));
-        if (!out || d > *out) out = d;
-      }
-  return out;
-}
-
-// The largest |q_L2(c) − q_L(c)| over the bracket Ca c ∈ {a, b}, with q_L2(c) interpolated linearly between
-// g2's nearest samples on either side of c (or taken at c): for a level sampled elsewhere (nullopt where g2's
-// samples do not span c).
-std::optional<double> interpolated_value_difference(const SampleGroup& g2, const SampleGroup& g, Quantity q, double a,
+// The largest |q_L2(c) − q_L(c)| over the bracket Ca c ∈ {a, b}: q_L2(c) taken at c where g2 has a sample
+// there (a check level run at the brackets), else interpolated linearly between g2's nearest samples on either
+// side of c (a level sampled elsewhere); nullopt where g2's samples do not span c.
+std::optional<double> value_difference(const SampleGroup& g2, const SampleGroup& g, Quantity q, double a,
                                                     double b) {
   std::optional<double> out;
   const auto coarse = with_value(g2, q);
@@ -180,7 +168,7 @@ Part mesh_part(const Cell& cell, int level, Answer which, double a, double b, do
     const LevelCrossing c = level_answer(*it->second, which, a, b, thr, l > level ? cell.by_level.at(level) : nullptr);
     out = c.ca;
     if (!out) {
-      const auto d = interpolated_value_difference(*it->second, *cell.by_level.at(level), q, a, b);
+      const auto d = value_difference(*it->second, *cell.by_level.at(level), q, a, b);
       if (!d || !(std::fabs(slope) > 0) || !std::isfinite(slope)) return;
       const double e = *d / std::fabs(slope);
       if (!values_e || e > *values_e) {

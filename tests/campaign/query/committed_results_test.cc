@@ -53,8 +53,7 @@ TEST(CommittedResults, BendingTableIsWhatTheDatabaseGives) {
   expect_query_reproduces("bending/table1_bending.sqlite", "bending/table1_kb1e-3.json", "table1-bending-1e-3");
 }
 
-// κ_b = 1e-2: the campaign is not finished (three Ca* bisections queued); the committed file is its state as the
-// database holds it.
+// κ_b = 1e-2: the campaign is complete (2026-12-05); the committed file is its final state.
 TEST(CommittedResults, StifferBendingTableIsWhatTheDatabaseGives) {
   expect_query_reproduces("bending/table1_bending.sqlite", "bending/table1_kb1e-2.json", "table1-bending-1e-2");
 }

@@ -32,6 +32,7 @@ CapsuleFlow::CapsuleFlow(const config::CaseConfig& c) : Ca_(c.capillary_number) 
   so.duffy_order = c.duffy_order;
   so.far_degree = c.far_degree;
   so.far_radius = c.far_radius;
+  so.precision = c.kernel_precision == "mixed" ? stokes::KernelPrecision::Mixed : stokes::KernelPrecision::Double;
   single_layer_ = std::make_unique<stokes::SingleLayer>(*mesh_, so);
   volume_correction_ = c.volume_correction;
   flux_rule_ = mesh::P2Tabulation::of_degree(6);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 #include "solver/config/case_config.h"
@@ -37,7 +38,9 @@ Eigen::Matrix3Xd deformed(const Eigen::Matrix3Xd& ref, bool symmetric) {
   return x;
 }
 
-FlowBenchScene measure_scene(CapsuleFlow& flow, const Eigen::Matrix3Xd& x, const std::string& name, int repeat) {
+// `in_double`: the same case in double precision, timed alternately too (nullptr: the evaluation is double).
+FlowBenchScene measure_scene(CapsuleFlow& flow, CapsuleFlow* in_double, const Eigen::Matrix3Xd& x,
+                             const std::string& name, int repeat) {
   FlowBenchScene sc;
   sc.name = name;
   sc.nodes = static_cast<int>(x.cols());
@@ -72,12 +75,19 @@ FlowBenchScene measure_scene(CapsuleFlow& flow, const Eigen::Matrix3Xd& x, const
   stokes::kernel::sum_fast(tg, src.sources(), res, fast);  // warm-up
 
   // Alternate evaluation and bare sum, so that both see the same machine state.
-  std::vector<double> eval_ms, bare_ms;
+  std::vector<double> eval_ms, bare_ms, double_ms;
+  Eigen::Matrix3Xd vd;
+  if (in_double) in_double->velocity(x, vd);  // warm-up
   const FlowTimings before = flow.timings();
   for (int r = 0; r < repeat; ++r) {
     double t0 = now_ms();
     flow.velocity(x, v);
     eval_ms.push_back(now_ms() - t0);
+    if (in_double) {
+      t0 = now_ms();
+      in_double->velocity(x, vd);
+      double_ms.push_back(now_ms() - t0);
+    }
     t0 = now_ms();
     stokes::kernel::sum_fast(tg, src.sources(), res, fast);
     bare_ms.push_back(now_ms() - t0);
@@ -85,6 +95,7 @@ FlowBenchScene measure_scene(CapsuleFlow& flow, const Eigen::Matrix3Xd& x, const
   const FlowTimings& after = flow.timings();
   sc.repeat = repeat;
   sc.evaluation_ms = median(eval_ms);
+  if (in_double) sc.evaluation_double_ms = median(double_ms);
   sc.regular_sum_ms = median(bare_ms);
   sc.overhead_ratio = sc.evaluation_ms / sc.regular_sum_ms;
   const double per = 1e3 / repeat;
@@ -115,6 +126,10 @@ bool FlowBenchOptions::valid(std::string* why) const {
     if (why) *why = "bending modulus must be in [0, 1], got " + std::to_string(bending_modulus);
     return false;
   }
+  if (kernel_precision != "double" && kernel_precision != "mixed") {
+    if (why) *why = "kernel precision must be \"double\" or \"mixed\", got \"" + kernel_precision + "\"";
+    return false;
+  }
   if (repeat < 0 || repeat > 100000) {
     if (why) *why = "repeat must be 0 (automatic) .. 100000, got " + std::to_string(repeat);
     return false;
@@ -130,7 +145,14 @@ FlowBenchReport bench_flow(const FlowBenchOptions& options) {
   c.capillary_number = 0.3;
   c.level = options.level;
   c.bending_modulus = options.bending_modulus;
+  c.kernel_precision = options.kernel_precision;
   CapsuleFlow flow(c);
+  std::unique_ptr<CapsuleFlow> in_double;
+  if (options.kernel_precision != "double") {
+    config::CaseConfig cd = c;
+    cd.kernel_precision = "double";
+    in_double = std::make_unique<CapsuleFlow>(cd);
+  }
   FlowBenchReport report;
   report.level = options.level;
   report.threads = omp_get_max_threads();
@@ -139,7 +161,7 @@ FlowBenchReport bench_flow(const FlowBenchOptions& options) {
   const int repeat =
       options.repeat > 0 ? options.repeat : std::clamp(static_cast<int>(40.0 * std::pow(4.0, 3 - options.level)), 5, 400);
   for (const bool symmetric : {true, false})
-    report.scenes.push_back(measure_scene(flow, deformed(flow.reference(), symmetric),
+    report.scenes.push_back(measure_scene(flow, in_double.get(), deformed(flow.reference(), symmetric),
                                           symmetric ? "symmetric" : "general", repeat));
   return report;
 }

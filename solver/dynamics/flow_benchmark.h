@@ -25,6 +25,9 @@ struct FlowBenchOptions {
   int level = 3;   ///< mesh level (1..6)
   int repeat = 0;  ///< timed evaluations per scene; 0 = automatic (about a second per scene, 5..400)
   double bending_modulus = 0.0;  ///< capsule.bending_modulus of the scene (0: the seed's membrane)
+  /// numerics.kernel_precision of the evaluation: "double" or "mixed". With "mixed" the same scene is also
+  /// evaluated in double, alternately in the same run (FlowBenchScene::evaluation_double_ms): the speed-up.
+  std::string kernel_precision = "double";
   /// @brief Whether the options are usable; if not and why is not null, *why says which and why.
   [[nodiscard]] bool valid(std::string* why = nullptr) const;
 };
@@ -38,6 +41,7 @@ struct FlowBenchScene {
   bool used_symmetry = false;   ///< whether the evaluation used the mirror symmetry
   int repeat = 0;               ///< timed evaluations (and as many bare sums)
   double evaluation_ms = 0.0;   ///< median wall time of CapsuleFlow::velocity
+  double evaluation_double_ms = 0.0;  ///< the same in double precision (only with kernel_precision "mixed"; else 0)
   double regular_sum_ms = 0.0;  ///< median wall time of the bare kernel::sum_fast over the same targets/sources
   double overhead_ratio = 0.0;  ///< evaluation_ms / regular_sum_ms
   // Mean time per evaluation of each named phase (CapsuleFlow / SingleLayer timers).

@@ -14,7 +14,8 @@
 ///  1. Layout (source_layout.h): one triangle rule (degree 4/5/6) on every element; all quadrature points of
 ///     the surface are laid out once per call as structure-of-arrays (x, y, z and w·|∂x/∂ξ × ∂x/∂η|·q),
 ///     padded to the SIMD width with zero loads.
-///  2. Regular part: kernel::sum_fast (or sum_plain) sums them for all targets.
+///  2. Regular part: kernel::sum_fast (or sum_plain; or sum_mixed with Options::precision = Mixed) sums them
+///     for all targets.
 ///  3. Far-field tier (far_field.h; Options::far_degree > 0, off by default): the all-pairs sum of phase 2
 ///     runs over a COARSE rule instead, and each target's near ("mid") elements are upgraded back to the
 ///     regular rule, so the phases below apply unchanged.
@@ -69,6 +70,13 @@ enum class Symmetry {
 /// @brief Which Stokeslet sum the regular part uses.
 enum class KernelChoice { Fast, Plain };
 
+/// @brief Working precision of the regular part's pair terms (numerics.kernel_precision). Double: every
+/// phase in double. Mixed: the all-pairs regular (or far-field coarse) sum by kernel::sum_mixed — pair terms
+/// in float, sums in double, ≈ 3e-7 of |u| — while the singular, near-singular and far-field corrections,
+/// which hold the large terms of the elements next to each target, stay in double. Ignored with
+/// KernelChoice::Plain (the reference).
+enum class KernelPrecision { Double, Mixed };
+
 /// @brief Options of the single-layer operator.
 ///
 /// The case registry (solver/config/case_config.h) owns the user-facing keys numerics.regular_degree,
@@ -91,6 +99,7 @@ struct SingleLayerOptions {
   Symmetry symmetry = Symmetry::Auto;
   double symmetry_tol = 1e-10; ///< relative tolerance of the symmetry check (≥ 0)
   KernelChoice kernel = KernelChoice::Fast;
+  KernelPrecision precision = KernelPrecision::Double;  ///< of the fast regular sum (see KernelPrecision)
   kernel::FastConfig fast{};   ///< tuning of the fast kernel (block 1..4)
 
   /// @brief Whether the operator can be built with these options; if not and why is not null, *why names

@@ -109,6 +109,28 @@ void sum_plain(const Targets& t, const Sources& s, const Result& u);
 /// sources); a source at the target contributes nothing. Serial: call it from the caller's parallel loop.
 void sum_blocks(const double x0[3], const Sources& s, const int* begins, int count, int length, double u[3]);
 
+/// @brief The regular sum in mixed precision (numerics.kernel_precision = "mixed"): the same sum as sum_fast,
+/// with every pair term in single precision and the sums in double. Targets, sources and loads are rounded to
+/// float once per call; 1/r is the float hardware estimate refined by one Newton step (relative error
+/// ≈ 2e-7); each target accumulates its terms in float over blocks of kMixedBlock sources and adds the block
+/// sums in double. Why it is accurate enough: the rounding of the positions (≈ 6e-8 absolute for a capsule
+/// of size 1) changes a term at distance r by ≈ 6e-8/r relative, and the regular sum never sees r below
+/// ≈ h/10 from a node (the Duffy and near-singular phases replace those elements, in double). Measured:
+/// 2–3e-7 of |u| per target on the level-2 and level-3 problems (tests/solver/stokes/kernel_test.cc); it
+/// moves the operator's most accurate identity, the sphere's Stokes drag (6e-6 at level 3), by 1 %, and a
+/// level-3 case's min D12 by 7e-7 where the mesh moves it by 1e-2 (results/speed/mixed_ab_case.json). Why it
+/// exists: twice the lanes and a cheaper 1/r make the hot loop ≈ 2.7× faster on AVX2 (results/benchmarks.md,
+/// "Mixed precision"). Same contract as sum_fast (u overwritten, a source at zero distance contributes
+/// nothing, OpenMP-parallel over targets); NaN propagates.
+void sum_mixed(const Targets& t, const Sources& s, const Result& u);
+
+/// @brief Sources a target sums in float before the partial sum is added in double (sum_mixed).
+inline constexpr int kMixedBlock = 256;
+
+/// @brief Instruction set of sum_mixed in this build: "avx2" (also on AVX-512 machines: 8 float lanes) or
+/// "portable".
+const char* mixed_kernel_isa();
+
 /// @brief Instruction set of sum_fast in this build: "avx512", "avx2" or "portable".
 const char* kernel_isa();
 

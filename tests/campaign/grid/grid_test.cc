@@ -130,6 +130,8 @@ TEST(Identity, StableAndSensitiveToWhatMatters) {
   explicit_default.set("capsule.bending_modulus", 0.0);
   EXPECT_EQ(explicit_default.identity("abc"), p.identity("abc"));
   EXPECT_EQ(explicit_default.canonical().find("bending"), std::string::npos);
+  explicit_default.set("numerics.kernel_precision", std::string("double"));  // so is numerics.kernel_precision
+  EXPECT_EQ(explicit_default.identity("abc"), p.identity("abc"));
   // Changes that matter.
   for (auto [k, v] : std::vector<std::pair<std::string, Value>>{{"flow.capillary_number", 0.31},
                                                                 {"capsule.aspect_ratio", 0.5},
@@ -141,7 +143,8 @@ TEST(Identity, StableAndSensitiveToWhatMatters) {
                                                                 {"time.dt_factor", 0.2},
                                                                 {"time.scheme", std::string("rk2")},
                                                                 {"numerics.regular_degree", std::int64_t{6}},
-                                                                {"capsule.bending_modulus", 1e-3}}) {
+                                                                {"capsule.bending_modulus", 1e-3},
+                                                                {"numerics.kernel_precision", std::string("mixed")}}) {
     CaseParams q = p;
     q.set(k, v);
     EXPECT_NE(q.identity("abc"), p.identity("abc")) << k;

@@ -56,6 +56,26 @@ TEST(CaseConfig, FarFieldKeysAreListed) {
   EXPECT_NE(std::find(names.begin(), names.end(), "numerics.far_radius"), names.end());
 }
 
+// numerics.kernel_precision: "double" unless set; "mixed" from a file or --set; anything else refused with the
+// key's name (exit 2 at the command line).
+TEST(CaseConfig, KernelPrecisionDefaultsToDoubleAndAcceptsOnlyItsTwoValues) {
+  const CaseConfig c = parse_case_config("", "empty");
+  EXPECT_EQ(c.kernel_precision, "double");
+  EXPECT_EQ(c.to_map().at("numerics.kernel_precision"), "\"double\"");
+  EXPECT_EQ(parse_case_config("[numerics]\nkernel_precision = \"mixed\"\n", "case.toml").kernel_precision, "mixed");
+  const CaseConfig m = parse_case_config("", "case.toml", {"numerics.kernel_precision=mixed"});
+  EXPECT_EQ(m.kernel_precision, "mixed");
+  EXPECT_EQ(parse_case_config(m.to_toml(), "echo").to_map(), m.to_map());
+  for (const char* bad : {"numerics.kernel_precision=single", "numerics.kernel_precision=float"}) {
+    try {
+      (void)parse_case_config("", "case.toml", {bad});
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("numerics.kernel_precision"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(CaseConfig, BendingModulusDefaultsToNoneAndIsRangeChecked) {
   EXPECT_EQ(parse_case_config("", "empty").bending_modulus, 0.0);
   EXPECT_EQ(parse_case_config("[capsule]\nbending_modulus = 1e-3\n", "case.toml").bending_modulus, 1e-3);

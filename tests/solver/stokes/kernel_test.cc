@@ -198,5 +198,43 @@ TEST(StokesletKernel, Level2ProblemFastEqualsPlain) {
   EXPECT_LT(max_rel(fx, fy, fz, px, py, pz), 1e-12);
 }
 
+// sum_mixed (numerics.kernel_precision = "mixed"): pair terms in float, sums in double. Against the plain
+// double loop on the level-2 and level-3 problems (targets = nodes, sources = the regular quadrature points of
+// the same mesh: the distances of a real evaluation, none below ≈ h/10). The bound follows from float
+// arithmetic, not from a measurement: each term carries a few float roundings (2^-24 ≈ 6e-8 each, 1/r after
+// one Newton step ≈ 2e-7) and the positions' rounding (6e-8 absolute) over r ≥ h/10; per target the float
+// partial sums of kMixedBlock terms add at most ≈ kMixedBlock · 6e-8 of their size. 1e-5 of |u| at each
+// target holds those with room; the estimate 1/r without its Newton step (error 3.7e-4) or a load rounded to
+// half precision would not. The partial last tile (642 = 40 · 16 + 2 targets) is covered by level 2.
+TEST(StokesletKernel, MixedPrecisionIsWithinFloatAccuracyOfThePlainSum) {
+  for (const int level : {2, 3}) {
+    const KernelProblem p = make_kernel_problem(level);
+    const int n = p.num_targets();
+    std::vector<double> mx(n), my(n), mz(n), px(n), py(n), pz(n);
+    sum_mixed(p.targets(), p.sources(), {mx.data(), my.data(), mz.data()});
+    sum_plain(p.targets(), p.sources(), {px.data(), py.data(), pz.data()});
+    const double e = max_rel(mx, my, mz, px, py, pz);
+    std::printf("  level %d (%s): mixed vs plain, max relative difference per target %.2e\n", level,
+                mixed_kernel_isa(), e);
+    EXPECT_LT(e, 1e-5) << "level " << level;
+    EXPECT_GT(e, 0.0) << "float terms cannot reproduce the double sum exactly";
+  }
+}
+
+TEST(StokesletKernel, MixedPrecisionMasksZeroDistanceAndPropagatesNaN) {
+  const std::vector<double> sx = {0.0, 1.0}, sy = {0.0, 0.0}, sz = {0.0, 0.0}, q1 = {1.0, 1.0}, q0 = {0.0, 0.0};
+  const Sources s{sx.data(), sy.data(), sz.data(), q1.data(), q0.data(), q0.data(), 2};
+  const double t0 = 0.0;
+  double ux = 0, uy = 0, uz = 0;
+  sum_mixed({&t0, &t0, &t0, 1}, s, {&ux, &uy, &uz});
+  EXPECT_DOUBLE_EQ(ux, 2.0);  // exact in float too: r = −e1, J·e1 = 2 e1
+  EXPECT_DOUBLE_EQ(uy, 0.0);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<double> sxn = {nan, 1.0};
+  const Sources sn{sxn.data(), sy.data(), sz.data(), q1.data(), q0.data(), q0.data(), 2};
+  sum_mixed({&t0, &t0, &t0, 1}, sn, {&ux, &uy, &uz});
+  EXPECT_TRUE(std::isnan(ux));
+}
+
 }  // namespace
 }  // namespace capsim::stokes::kernel

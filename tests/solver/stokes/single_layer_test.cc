@@ -221,6 +221,51 @@ TEST(SingleLayerFarField, OffIsTheRegularRuleEverywhere) {
   }
 }
 
+// numerics.kernel_precision = "mixed": the all-pairs sum in float terms, the corrections next to each target in
+// double. On the sphere's Stokes-drag identity the operator's error must stay that of the double operator
+// (6e-6 at level 3: this identity is the most accurate field the operator computes, so it is the hardest test
+// of the float terms): within 20 % of it, and the deformed asymmetric scene within 1e-5 of the double result.
+TEST(SingleLayer, MixedPrecisionKeepsTheOperatorsAccuracy) {
+  SingleLayerOptions mixed;
+  mixed.precision = KernelPrecision::Mixed;
+  for (const int level : {2, 3}) {
+    const double full = uniform_load_error(level), err = uniform_load_error(level, mixed);
+    std::printf("  level %d: Stokes drag max rel error, double %.3e, mixed %.3e\n", level, full, err);
+    EXPECT_LT(std::fabs(err - full), 0.2 * full) << "level " << level;
+    const auto m = mesh::make_sphere_mesh(level);
+    Matrix3Xd x, q;
+    deformed_scene(m, x, q);
+    SingleLayer op(m), opm(m, mixed);
+    const double diff = rel_diff(opm.apply(x, q), op.apply(x, q));
+    std::printf("  level %d: deformed scene, mixed vs double max diff / max |u| %.2e\n", level, diff);
+    EXPECT_LT(diff, 1e-5) << "level " << level;
+  }
+}
+
+// Mixed precision and the mirror symmetry: the nodes on the plane x3 = 0 get u3 = 0 exactly (the float sum
+// leaves ≈ 1e-7 |u| there, which would move them off the plane and end the symmetric evaluation within a few
+// steps: tests/solver/dynamics/capsule_flow_test.cc), and the symmetric result equals the full one to the
+// mixed kernel's accuracy.
+TEST(SingleLayer, MixedPrecisionKeepsTheMirrorPlaneExact) {
+  const auto m = mesh::make_capsule_mesh(2, 2.0);
+  Matrix3Xd x, q;
+  symmetric_scene(m, x, q);
+  SingleLayerOptions mixed, mixed_full;
+  mixed.precision = mixed_full.precision = KernelPrecision::Mixed;
+  mixed_full.symmetry = Symmetry::Off;
+  SingleLayer sym(m, mixed), full(m, mixed_full);
+  const Matrix3Xd us = sym.apply(x, q), uf = full.apply(x, q);
+  ASSERT_TRUE(sym.last_stats().used_symmetry);
+  int on_plane = 0;
+  for (int i = 0; i < m.num_nodes(); ++i)
+    if (m.mirror_node[i] == i) {
+      ++on_plane;
+      EXPECT_EQ(us(2, i), 0.0) << "node " << i;
+    }
+  EXPECT_GT(on_plane, 0);
+  EXPECT_LT((us - uf).cwiseAbs().maxCoeff() / uf.cwiseAbs().maxCoeff(), 1e-5);
+}
+
 // The operator's defaults are those of the case registry: a default-constructed operator (tests,
 // benchmarks) is the operator of a default case. (Before issue 12, duffy_order was 6 here and 8 there.)
 TEST(SingleLayer, DefaultsAreTheCaseRegistrys) {
@@ -230,6 +275,7 @@ TEST(SingleLayer, DefaultsAreTheCaseRegistrys) {
   EXPECT_EQ(o.duffy_order, c.duffy_order);
   EXPECT_EQ(o.far_degree, c.far_degree);
   EXPECT_EQ(o.far_radius, c.far_radius);
+  EXPECT_EQ(o.precision == KernelPrecision::Mixed ? "mixed" : "double", c.kernel_precision);
   EXPECT_TRUE(o.valid());
 }
 

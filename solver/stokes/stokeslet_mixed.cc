@@ -1,0 +1,155 @@
+// The regular Stokeslet sum in mixed precision (stokeslet.h, sum_mixed): pair terms in float, sums in double.
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "solver/stokes/stokeslet.h"
+
+#if defined(__AVX2__) && defined(__FMA__)
+#include <immintrin.h>
+#endif
+
+namespace capsim::stokes::kernel {
+namespace {
+
+// Structure-of-arrays in float (one rounding per coordinate and load component).
+struct FloatSoA {
+  std::vector<float> x, y, z, qx, qy, qz;
+};
+
+void to_float(const double* in, int n, std::vector<float>& out) {
+  out.resize(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) out[i] = static_cast<float>(in[i]);
+}
+
+#if defined(__AVX2__) && defined(__FMA__)
+constexpr int kLanes = 8;   // floats per __m256
+constexpr int kBlock = 2;   // target vectors per tile (register blocking: 2 × 8 targets)
+constexpr const char* kIsa = "avx2";
+
+// kBlock × 8 targets against all sources. Per block of kMixedBlock sources the float accumulators are added
+// into double ones (two __m256d per __m256).
+inline void tile(const float* tx, const float* ty, const float* tz, const FloatSoA& s, int ns, double* ux, double* uy,
+                 double* uz) {
+  __m256 X[kBlock], Y[kBlock], Z[kBlock], UX[kBlock], UY[kBlock], UZ[kBlock];
+  __m256d DX[2 * kBlock], DY[2 * kBlock], DZ[2 * kBlock];
+  for (int b = 0; b < kBlock; ++b) {
+    X[b] = _mm256_loadu_ps(tx + kLanes * b);
+    Y[b] = _mm256_loadu_ps(ty + kLanes * b);
+    Z[b] = _mm256_loadu_ps(tz + kLanes * b);
+  }
+  for (int b = 0; b < 2 * kBlock; ++b) DX[b] = DY[b] = DZ[b] = _mm256_setzero_pd();
+  const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f), three = _mm256_set1_ps(3.0f);
+  const float *sx = s.x.data(), *sy = s.y.data(), *sz = s.z.data();
+  const float *sqx = s.qx.data(), *sqy = s.qy.data(), *sqz = s.qz.data();
+  for (int j0 = 0; j0 < ns; j0 += kMixedBlock) {
+    for (int b = 0; b < kBlock; ++b) UX[b] = UY[b] = UZ[b] = _mm256_setzero_ps();
+    const int j1 = std::min(ns, j0 + kMixedBlock);
+    for (int j = j0; j < j1; ++j) {
+      const __m256 px = _mm256_broadcast_ss(sx + j), py = _mm256_broadcast_ss(sy + j), pz = _mm256_broadcast_ss(sz + j);
+      const __m256 qx = _mm256_broadcast_ss(sqx + j), qy = _mm256_broadcast_ss(sqy + j),
+                   qz = _mm256_broadcast_ss(sqz + j);
+      for (int b = 0; b < kBlock; ++b) {
+        const __m256 dx = _mm256_sub_ps(X[b], px), dy = _mm256_sub_ps(Y[b], py), dz = _mm256_sub_ps(Z[b], pz);
+        const __m256 r2 = _mm256_fmadd_ps(dz, dz, _mm256_fmadd_ps(dy, dy, _mm256_mul_ps(dx, dx)));
+        const __m256 keep = _mm256_cmp_ps(r2, zero, _CMP_NEQ_UQ);  // r = 0 masked, NaN kept
+        __m256 y = _mm256_and_ps(_mm256_rsqrt_ps(r2), keep);
+        // One Newton step, y (3 − r² y²)/2: the estimate's 1.5·2^-12 becomes ≈ 2e-7 (float rounding).
+        y = _mm256_mul_ps(_mm256_mul_ps(half, y), _mm256_fnmadd_ps(_mm256_mul_ps(r2, y), y, three));
+        const __m256 rq = _mm256_fmadd_ps(dz, qz, _mm256_fmadd_ps(dy, qy, _mm256_mul_ps(dx, qx)));
+        const __m256 s2 = _mm256_mul_ps(rq, _mm256_mul_ps(y, y));
+        UX[b] = _mm256_fmadd_ps(y, _mm256_fmadd_ps(dx, s2, qx), UX[b]);
+        UY[b] = _mm256_fmadd_ps(y, _mm256_fmadd_ps(dy, s2, qy), UY[b]);
+        UZ[b] = _mm256_fmadd_ps(y, _mm256_fmadd_ps(dz, s2, qz), UZ[b]);
+      }
+    }
+    for (int b = 0; b < kBlock; ++b) {
+      auto widen = [](__m256 v, __m256d& lo, __m256d& hi) {
+        lo = _mm256_add_pd(lo, _mm256_cvtps_pd(_mm256_castps256_ps128(v)));
+        hi = _mm256_add_pd(hi, _mm256_cvtps_pd(_mm256_extractf128_ps(v, 1)));
+      };
+      widen(UX[b], DX[2 * b], DX[2 * b + 1]);
+      widen(UY[b], DY[2 * b], DY[2 * b + 1]);
+      widen(UZ[b], DZ[2 * b], DZ[2 * b + 1]);
+    }
+  }
+  for (int b = 0; b < 2 * kBlock; ++b) {
+    _mm256_storeu_pd(ux + 4 * b, DX[b]);
+    _mm256_storeu_pd(uy + 4 * b, DY[b]);
+    _mm256_storeu_pd(uz + 4 * b, DZ[b]);
+  }
+}
+#else
+constexpr int kLanes = 8;
+constexpr int kBlock = 2;
+constexpr const char* kIsa = "portable";
+
+// Portable: the lanes as an inner loop the compiler vectorises; 1/r as 1/std::sqrt in float.
+inline void tile(const float* tx, const float* ty, const float* tz, const FloatSoA& s, int ns, double* ux, double* uy,
+                 double* uz) {
+  constexpr int W = kLanes * kBlock;
+  double dx_[W] = {}, dy_[W] = {}, dz_[W] = {};
+  for (int j0 = 0; j0 < ns; j0 += kMixedBlock) {
+    float ax[W] = {}, ay[W] = {}, az[W] = {};
+    const int j1 = std::min(ns, j0 + kMixedBlock);
+    for (int j = j0; j < j1; ++j) {
+      const float px = s.x[j], py = s.y[j], pz = s.z[j], qx = s.qx[j], qy = s.qy[j], qz = s.qz[j];
+#pragma omp simd
+      for (int l = 0; l < W; ++l) {
+        const float dx = tx[l] - px, dy = ty[l] - py, dz = tz[l] - pz;
+        const float r2 = dx * dx + dy * dy + dz * dz;
+        const float y = r2 == 0.0f ? 0.0f : 1.0f / std::sqrt(r2);
+        add_stokeslet(dx, dy, dz, qx, qy, qz, y, 1.0f, ax[l], ay[l], az[l]);
+      }
+    }
+    for (int l = 0; l < W; ++l) {
+      dx_[l] += ax[l];
+      dy_[l] += ay[l];
+      dz_[l] += az[l];
+    }
+  }
+  for (int l = 0; l < W; ++l) {
+    ux[l] = dx_[l];
+    uy[l] = dy_[l];
+    uz[l] = dz_[l];
+  }
+}
+#endif
+
+}  // namespace
+
+void sum_mixed(const Targets& t, const Sources& s, const Result& u) {
+  if (t.n <= 0) return;
+  constexpr int W = kLanes * kBlock;
+  // Targets padded to whole tiles with copies of the last one (their results are dropped).
+  const int ntiles = (t.n + W - 1) / W, padded = ntiles * W;
+  std::vector<float> tx(static_cast<std::size_t>(padded)), ty(tx.size()), tz(tx.size());
+  for (int i = 0; i < padded; ++i) {
+    const int k = std::min(i, t.n - 1);
+    tx[i] = static_cast<float>(t.x[k]);
+    ty[i] = static_cast<float>(t.y[k]);
+    tz[i] = static_cast<float>(t.z[k]);
+  }
+  FloatSoA f;
+  to_float(s.x, s.n, f.x);
+  to_float(s.y, s.n, f.y);
+  to_float(s.z, s.n, f.z);
+  to_float(s.qx, s.n, f.qx);
+  to_float(s.qy, s.n, f.qy);
+  to_float(s.qz, s.n, f.qz);
+#pragma omp parallel for schedule(static)
+  for (int it = 0; it < ntiles; ++it) {
+    const int i0 = it * W;
+    alignas(64) double ox[W], oy[W], oz[W];
+    tile(tx.data() + i0, ty.data() + i0, tz.data() + i0, f, s.n, ox, oy, oz);
+    for (int l = 0; l < W && i0 + l < t.n; ++l) {
+      u.x[i0 + l] = ox[l];
+      u.y[i0 + l] = oy[l];
+      u.z[i0 + l] = oz[l];
+    }
+  }
+}
+
+const char* mixed_kernel_isa() { return kIsa; }
+
+}  // namespace capsim::stokes::kernel

@@ -211,16 +211,7 @@ inline void tile(const double* tx, const double* ty, const double* tz, const Sou
                  double* uz) {
   constexpr int W = kLanes * B;
   double ax[W] = {}, ay[W] = {}, az[W] = {};
-  for (int j = 0; j < s.n; ++j) {
-    const double sx = s.x[j], sy = s.y[j], sz = s.z[j], qx = s.qx[j], qy = s.qy[j], qz = s.qz[j];
-#pragma omp simd
-    for (int l = 0; l < W; ++l) {
-      const double dx = tx[l] - sx, dy = ty[l] - sy, dz = tz[l] - sz;
-      const double r2 = dx * dx + dy * dy + dz * dz;
-      const double y = r2 == 0.0 ? 0.0 : 1.0 / std::sqrt(r2);
-      add_stokeslet(dx, dy, dz, qx, qy, qz, y, 1.0, ax[l], ay[l], az[l]);
-    }
-  }
+  add_sources_to_lanes<double, W>(tx, ty, tz, s.x, s.y, s.z, s.qx, s.qy, s.qz, 0, s.n, ax, ay, az);
   for (int l = 0; l < W; ++l) {
     ux[l] = ax[l];
     uy[l] = ay[l];

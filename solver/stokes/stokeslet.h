@@ -22,6 +22,7 @@
 /// parallel region; if they are, they run on the calling thread).
 
 #include <bit>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -167,6 +168,23 @@ inline void add_stokeslet_scaled(T rx, T ry, T rz, T qx, T qy, T qz, T inv_r2, T
 template <class T>
 inline void add_stokeslet(T rx, T ry, T rz, T qx, T qy, T qz, T inv_r, T w, T& ux, T& uy, T& uz) {
   add_stokeslet_scaled(rx, ry, rz, qx, qy, qz, inv_r * inv_r, w * inv_r, ux, uy, uz);
+}
+
+/// @brief W target lanes against the sources [j0, j1) in precision T, accumulated into a (the portable tiles of
+/// sum_fast and sum_mixed, for machines without AVX2: the lane loop is what the compiler vectorises).
+template <class T, int W>
+inline void add_sources_to_lanes(const T* tx, const T* ty, const T* tz, const T* sx, const T* sy, const T* sz,
+                                 const T* qx, const T* qy, const T* qz, int j0, int j1, T* ax, T* ay, T* az) {
+  for (int j = j0; j < j1; ++j) {
+    const T px = sx[j], py = sy[j], pz = sz[j], fx = qx[j], fy = qy[j], fz = qz[j];
+#pragma omp simd
+    for (int l = 0; l < W; ++l) {
+      const T dx = tx[l] - px, dy = ty[l] - py, dz = tz[l] - pz;
+      const T r2 = dx * dx + dy * dy + dz * dz;
+      const T y = r2 == T(0) ? T(0) : T(1) / std::sqrt(r2);
+      add_stokeslet(dx, dy, dz, fx, fy, fz, y, T(1), ax[l], ay[l], az[l]);
+    }
+  }
 }
 
 }  // namespace kernel

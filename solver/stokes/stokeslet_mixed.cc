@@ -91,17 +91,8 @@ inline void tile(const float* tx, const float* ty, const float* tz, const FloatS
   double dx_[W] = {}, dy_[W] = {}, dz_[W] = {};
   for (int j0 = 0; j0 < ns; j0 += kMixedBlock) {
     float ax[W] = {}, ay[W] = {}, az[W] = {};
-    const int j1 = std::min(ns, j0 + kMixedBlock);
-    for (int j = j0; j < j1; ++j) {
-      const float px = s.x[j], py = s.y[j], pz = s.z[j], qx = s.qx[j], qy = s.qy[j], qz = s.qz[j];
-#pragma omp simd
-      for (int l = 0; l < W; ++l) {
-        const float dx = tx[l] - px, dy = ty[l] - py, dz = tz[l] - pz;
-        const float r2 = dx * dx + dy * dy + dz * dz;
-        const float y = r2 == 0.0f ? 0.0f : 1.0f / std::sqrt(r2);
-        add_stokeslet(dx, dy, dz, qx, qy, qz, y, 1.0f, ax[l], ay[l], az[l]);
-      }
-    }
+    add_sources_to_lanes<float, W>(tx, ty, tz, s.x.data(), s.y.data(), s.z.data(), s.qx.data(), s.qy.data(),
+                                   s.qz.data(), j0, std::min(ns, j0 + kMixedBlock), ax, ay, az);
     for (int l = 0; l < W; ++l) {
       dx_[l] += ax[l];
       dy_[l] += ay[l];

@@ -57,6 +57,7 @@ std::string q(const fs::path& p) {
 std::string plot() { return kPython + " " + q(fs::path(kSrc) / "scripts" / "plot"); }
 std::string table1() { return kPython + " " + q(fs::path(kSrc) / "scripts" / "table1"); }
 std::string mesh_check() { return kPython + " " + q(fs::path(kSrc) / "scripts" / "mesh_check"); }
+std::string compare_campaigns() { return kPython + " " + q(fs::path(kSrc) / "scripts" / "compare_campaigns"); }
 
 bool is_png(const fs::path& p) {
   const std::string s = slurp(p);
@@ -367,6 +368,41 @@ TEST_F(ScriptsTest, MeshCheckComparesRunsOverOneWindow) {
   EXPECT_TRUE(is_png(png));
   const Cmd unwritable = sh(mesh_check() + " A=" + q(h5) + " --period 1 --plot " + q(dir_ / "no-such-dir" / "x.png"));
   EXPECT_EQ(unwritable.code, 2) << unwritable.err;
+}
+
+// scripts/compare_campaigns: two copies of the fixture database whose cases get real parameters, B's with an
+// extra key (as a mixed-precision rerun has) and one min D12 moved by 0.0123. Matched without that key, every
+// finished case pairs up, the largest difference is that one, at that case; without --ignore nothing matches
+// (exit 2); a missing database is exit 2 with one message.
+TEST_F(ScriptsTest, CompareCampaignsPairsTheSameCasesAndFindsTheLargestDifference) {
+  const auto a = dir_ / "cmp_a.sqlite", b = dir_ / "cmp_b.sqlite";
+  const std::string prep =
+      "import json, shutil, sqlite3, sys\n"
+      "for path, extra in ((sys.argv[1], {}), (sys.argv[2], {'numerics.kernel_precision': 'mixed'})):\n"
+      "    shutil.copy(sys.argv[3], path)\n"
+      "    con = sqlite3.connect(path)\n"
+      "    for cid, law, ar, ca in con.execute('SELECT case_id, law, aspect_ratio, capillary_number FROM cases').fetchall():\n"
+      "        p = dict({'capsule.law': law, 'capsule.aspect_ratio': ar, 'flow.capillary_number': ca, 'mesh.level': 1}, **extra)\n"
+      "        con.execute('UPDATE cases SET params_json = ? WHERE case_id = ?', (json.dumps(p), cid))\n"
+      "    if extra:\n"
+      "        con.execute(\"UPDATE results SET min_D12 = min_D12 + 0.0123 WHERE case_id = 'case0003'\")\n"
+      "    con.commit()\n";
+  std::ofstream(dir_ / "cmp_prep.py") << prep;
+  const Cmd made = sh(kPython + " " + q(dir_ / "cmp_prep.py") + " " + q(a) + " " + q(b) + " " + q(dir_ / "fixture.sqlite"));
+  ASSERT_EQ(made.code, 0) << made.err;
+  const Cmd r = sh(compare_campaigns() + " " + q(a) + " " + q(b) + " --ignore numerics.kernel_precision --capsim " +
+                   q(CAPSIM_EXE_PATH));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("22 cases finished in both"), std::string::npos) << r.out;  // 23 cases, one unstable
+  EXPECT_NE(r.out.find("| min_D12 | 1.23e-02 | NH a/b 0.5 Ca 0.05 L1 |"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("| max_tau_min | 0.00e+00 |"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Only in A (0)"), std::string::npos) << r.out;
+  const Cmd unmatched = sh(compare_campaigns() + " " + q(a) + " " + q(b) + " --capsim " + q(CAPSIM_EXE_PATH));
+  EXPECT_EQ(unmatched.code, 2) << unmatched.out;
+  EXPECT_NE(unmatched.err.find("--ignore"), std::string::npos) << unmatched.err;
+  const Cmd missing = sh(compare_campaigns() + " " + q(dir_ / "does-not-exist.sqlite") + " " + q(b));
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_EQ(count_lines(missing.err), 1) << missing.err;
 }
 
 TEST(SeedTable1, HoldsTheSeedValues) {

@@ -121,28 +121,32 @@ namespace {
 // number of threads (and a campaign's results do not depend on its layout). A parallel reduction in any
 // of them would break this test.
 TEST(CapsuleFlow, VelocityIsBitwiseTheSameOnOneAndTwoThreads) {
-  config::CaseConfig c;
-  c.level = 2;
-  c.aspect_ratio = 2.0;
-  c.capillary_number = 0.3;
-  dynamics::CapsuleFlow flow(c);
-  Eigen::Matrix3Xd x = flow.reference();
-  for (int i = 0; i < x.cols(); ++i) {  // smooth and asymmetric: all targets, non-trivial loads
-    const double x1 = x(0, i), x2 = x(1, i), x3 = x(2, i);
-    x(0, i) = x1 * (1.0 + 0.08 * std::sin(1.3 * x2 + 0.4 * x3));
-    x(1, i) = x2 + 0.05 * std::cos(x1) + 0.03 * x3;
+  for (const char* precision : {"double", "mixed"}) {  // sum_mixed too: each target's sum is one thread's
+    SCOPED_TRACE(precision);
+    config::CaseConfig c;
+    c.level = 2;
+    c.aspect_ratio = 2.0;
+    c.capillary_number = 0.3;
+    c.kernel_precision = precision;
+    dynamics::CapsuleFlow flow(c);
+    Eigen::Matrix3Xd x = flow.reference();
+    for (int i = 0; i < x.cols(); ++i) {  // smooth and asymmetric: all targets, non-trivial loads
+      const double x1 = x(0, i), x2 = x(1, i), x3 = x(2, i);
+      x(0, i) = x1 * (1.0 + 0.08 * std::sin(1.3 * x2 + 0.4 * x3));
+      x(1, i) = x2 + 0.05 * std::cos(x1) + 0.03 * x3;
+    }
+    const int before = omp_get_max_threads();
+    Eigen::Matrix3Xd v1, v2, q1, q2;
+    omp_set_num_threads(1);
+    const dynamics::FlowEvaluation e1 = flow.velocity(x, v1, &q1);
+    omp_set_num_threads(2);
+    const dynamics::FlowEvaluation e2 = flow.velocity(x, v2, &q2);
+    omp_set_num_threads(before);
+    EXPECT_EQ((q1 - q2).cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_EQ((v1 - v2).cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_EQ(e1.tau_min, e2.tau_min);
+    EXPECT_EQ(e1.volume_flux, e2.volume_flux);
   }
-  const int before = omp_get_max_threads();
-  Eigen::Matrix3Xd v1, v2, q1, q2;
-  omp_set_num_threads(1);
-  const dynamics::FlowEvaluation e1 = flow.velocity(x, v1, &q1);
-  omp_set_num_threads(2);
-  const dynamics::FlowEvaluation e2 = flow.velocity(x, v2, &q2);
-  omp_set_num_threads(before);
-  EXPECT_EQ((q1 - q2).cwiseAbs().maxCoeff(), 0.0);
-  EXPECT_EQ((v1 - v2).cwiseAbs().maxCoeff(), 0.0);
-  EXPECT_EQ(e1.tau_min, e2.tau_min);
-  EXPECT_EQ(e1.volume_flux, e2.volume_flux);
 }
 
 }  // namespace

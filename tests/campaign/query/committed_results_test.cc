@@ -41,6 +41,11 @@ TEST(CommittedResults, MultiFidelityTableIsWhatTheDatabaseGives) {
   expect_query_reproduces("table1_mf.sqlite", "table1_mf.json");
 }
 
+// What scripts/run computes since 2026-12-05 (the same preset with the Stokeslet sum in mixed precision).
+TEST(CommittedResults, MixedPrecisionMultiFidelityTableIsWhatTheDatabaseGives) {
+  expect_query_reproduces("table1_mf_mixed.sqlite", "table1_mf_mixed.json");
+}
+
 // The certified campaign shares its database with the multi-fidelity one it continues; the query's default
 // campaign is the most recently run, the certified one.
 TEST(CommittedResults, CertifiedTableIsWhatTheDatabaseGives) {

@@ -72,7 +72,7 @@ enum class KernelChoice { Fast, Plain };
 
 /// @brief Working precision of the regular part's pair terms (numerics.kernel_precision). Double: every
 /// phase in double. Mixed: the all-pairs regular (or far-field coarse) sum by kernel::sum_mixed — pair terms
-/// in float, sums in double, ≈ 3e-7 of |u| — while the singular, near-singular and far-field corrections,
+/// in float, sums in double (its error: kernel::sum_mixed) — while the singular, near-singular and far-field corrections,
 /// which hold the large terms of the elements next to each target, stay in double. Ignored with
 /// KernelChoice::Plain (the reference).
 enum class KernelPrecision { Double, Mixed };

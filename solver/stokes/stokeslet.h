@@ -116,13 +116,13 @@ void sum_blocks(const double x0[3], const Sources& s, const int* begins, int cou
 /// ≈ 2e-7); each target accumulates its terms in float over blocks of kMixedBlock sources and adds the block
 /// sums in double. Why it is accurate enough: the rounding of the positions (≈ 6e-8 absolute for a capsule
 /// of size 1) changes a term at distance r by ≈ 6e-8/r relative, and the regular sum never sees r below
-/// ≈ h/10 from a node (the Duffy and near-singular phases replace those elements, in double). Measured:
-/// 2–3e-7 of |u| per target on the level-2 and level-3 problems (tests/solver/stokes/kernel_test.cc); it
-/// moves the operator's most accurate identity, the sphere's Stokes drag (6e-6 at level 3), by 1 %, and a
-/// level-3 case's min D12 by 7e-7 where the mesh moves it by 1e-2 (results/speed/mixed_ab_case.json). Why it
-/// exists: twice the lanes and a cheaper 1/r make the hot loop ≈ 2.7× faster on AVX2 (results/benchmarks.md,
-/// "Mixed precision"). Same contract as sum_fast (u overwritten, a source at zero distance contributes
-/// nothing, OpenMP-parallel over targets); NaN propagates.
+/// ≈ h/10 from a node (the Duffy and near-singular phases replace those elements, in double): the tests
+/// require 1e-5 of |u| per target (tests/solver/stokes/kernel_test.cc), far below the discretisation error;
+/// what it moves in whole cases and campaigns is in results/speed/mixed_ab_case.json and
+/// results/table1_mf_mixed.md. Why it exists: twice the SIMD lanes and a cheaper 1/r (speed-ups in
+/// results/benchmarks.md, "Mixed precision"). Same contract as sum_fast (u overwritten, a source at zero
+/// distance contributes nothing, OpenMP-parallel over targets, each target's sum independent of the thread
+/// count); NaN propagates.
 void sum_mixed(const Targets& t, const Sources& s, const Result& u);
 
 /// @brief Sources a target sums in float before the partial sum is added in double (sum_mixed).

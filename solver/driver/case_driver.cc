@@ -108,7 +108,7 @@ class CaseRun {
       } catch (const io::IoError& e) {
         throw config::ConfigError(std::string(e.what()) + " (remove it to start afresh)");  // bad input, not output
       }
-      if (cp.strings["case"] != identity_ || cp.positions.cols() != mesh().num_nodes())
+      if (!same_case(cp.strings["case"]) || cp.positions.cols() != mesh().num_nodes())
         throw config::ConfigError(checkpoint_file_.string() + ": checkpoint belongs to another case (parameters differ)");
       x_ = cp.positions;
       t_ = cp.time;
@@ -329,6 +329,18 @@ class CaseRun {
       return *w;
     }
     return {};
+  }
+
+  /// A checkpoint's case is this one when its stored TOML, read by today's parser, gives the same effective
+  /// configuration: a key added to the registry after the checkpoint was written takes its default there, so
+  /// an old checkpoint still resumes (its text lacks the key) while any differing value is refused.
+  bool same_case(const std::string& stored) const {
+    if (stored == identity_) return true;
+    try {
+      return config::parse_case_config(stored, checkpoint_file_.string()).to_toml() == identity_;
+    } catch (const config::ConfigError&) {
+      return false;  // a key the registry no longer has, or a value it no longer accepts
+    }
   }
 
   double at_or_after(double interval) const {

@@ -117,17 +117,23 @@ FlowBenchScene measure_scene(CapsuleFlow& flow, CapsuleFlow* in_double, const Ei
 
 }  // namespace
 
+config::CaseConfig FlowBenchOptions::scene_case() const {
+  config::CaseConfig c;
+  c.aspect_ratio = 2.0;
+  c.law = "skalak";
+  c.capillary_number = 0.3;
+  c.level = level;
+  c.bending_modulus = bending_modulus;
+  c.kernel_precision = kernel_precision;
+  return c;
+}
+
 bool FlowBenchOptions::valid(std::string* why) const {
-  if (level < 1 || level > 6) {
-    if (why) *why = "level must be 1..6, got " + std::to_string(level);
-    return false;
-  }
-  if (!(bending_modulus >= 0.0 && bending_modulus <= 1.0)) {
-    if (why) *why = "bending modulus must be in [0, 1], got " + std::to_string(bending_modulus);
-    return false;
-  }
-  if (kernel_precision != "double" && kernel_precision != "mixed") {
-    if (why) *why = "kernel precision must be \"double\" or \"mixed\", got \"" + kernel_precision + "\"";
+  // The level, bending modulus and precision are case keys: the registry (case_keys.def) owns their ranges.
+  try {
+    scene_case().validate();
+  } catch (const config::ConfigError& e) {
+    if (why) *why = e.what();
     return false;
   }
   if (repeat < 0 || repeat > 100000) {
@@ -139,13 +145,7 @@ bool FlowBenchOptions::valid(std::string* why) const {
 
 FlowBenchReport bench_flow(const FlowBenchOptions& options) {
   if (std::string why; !options.valid(&why)) throw std::invalid_argument("bench flow: " + why);
-  config::CaseConfig c;
-  c.aspect_ratio = 2.0;
-  c.law = "skalak";
-  c.capillary_number = 0.3;
-  c.level = options.level;
-  c.bending_modulus = options.bending_modulus;
-  c.kernel_precision = options.kernel_precision;
+  const config::CaseConfig c = options.scene_case();
   CapsuleFlow flow(c);
   std::unique_ptr<CapsuleFlow> in_double;
   if (options.kernel_precision != "double") {

@@ -18,18 +18,23 @@
 #include <string>
 #include <vector>
 
+#include "solver/config/case_config.h"
+
 namespace capsim::dynamics {
 
 /// @brief What to measure.
 struct FlowBenchOptions {
-  int level = 3;   ///< mesh level (1..6)
+  int level = 3;   ///< mesh.level of the scene
   int repeat = 0;  ///< timed evaluations per scene; 0 = automatic (about a second per scene, 5..400)
   double bending_modulus = 0.0;  ///< capsule.bending_modulus of the scene (0: the seed's membrane)
   /// numerics.kernel_precision of the evaluation: "double" or "mixed". With "mixed" the same scene is also
   /// evaluated in double, alternately in the same run (FlowBenchScene::evaluation_double_ms): the speed-up.
   std::string kernel_precision = "double";
-  /// @brief Whether the options are usable; if not and why is not null, *why says which and why.
+  /// @brief Whether the options are usable; if not and why is not null, *why says which and why (the case
+  /// keys' ranges are the key registry's: the message names the key).
   [[nodiscard]] bool valid(std::string* why = nullptr) const;
+  /// @brief The measured scene as a case: the a/b = 2 Skalak capsule at Ca = 0.3 with these options' keys.
+  [[nodiscard]] config::CaseConfig scene_case() const;
 };
 
 /// @brief One scene's measurement. Times are milliseconds per evaluation.

@@ -116,8 +116,8 @@ void sum_blocks(const double x0[3], const Sources& s, const int* begins, int cou
 /// ≈ 2e-7); each target accumulates its terms in float over blocks of kMixedBlock sources and adds the block
 /// sums in double. Why it is accurate enough: the rounding of the positions (≈ 6e-8 absolute for a capsule
 /// of size 1) changes a term at distance r by ≈ 6e-8/r relative, and the regular sum never sees r below
-/// ≈ h/10 from a node (the Duffy and near-singular phases replace those elements, in double): the tests
-/// require 1e-5 of |u| per target (tests/solver/stokes/kernel_test.cc), far below the discretisation error;
+/// ≈ h/10 from a node (the Duffy and near-singular phases replace those elements, in double): per target it
+/// stays within kMixedRelativeBound of |u| (tests/solver/stokes/kernel_test.cc), far below the discretisation error;
 /// what it moves in whole cases and campaigns is in results/speed/mixed_ab_case.json and
 /// results/table1_mf_mixed.md. Why it exists: twice the SIMD lanes and a cheaper 1/r (speed-ups in
 /// results/benchmarks.md, "Mixed precision"). Same contract as sum_fast (u overwritten, a source at zero
@@ -127,6 +127,15 @@ void sum_mixed(const Targets& t, const Sources& s, const Result& u);
 
 /// @brief Sources a target sums in float before the partial sum is added in double (sum_mixed).
 inline constexpr int kMixedBlock = 256;
+
+/// @brief Contract of sum_mixed against the double sum: at most this relative difference per target, |Δu|/|u|,
+/// on a real evaluation's distances (none below ≈ h/10). It follows from float arithmetic (a few roundings of
+/// 2^-24 per term, 2e-7 for 1/r after its Newton step, kMixedBlock-term float partial sums) with room; the
+/// tests and `capsim bench kernel` hold the kernel to it.
+inline constexpr double kMixedRelativeBound = 1e-5;
+
+/// @brief Contract of sum_fast against the plain double loop: relative difference per target.
+inline constexpr double kFastRelativeBound = 1e-12;
 
 /// @brief Instruction set of sum_mixed in this build: "avx2" (also on AVX-512 machines: 8 float lanes) or
 /// "portable".

@@ -114,25 +114,33 @@ void sum_mixed(const Targets& t, const Sources& s, const Result& u) {
   constexpr int W = kLanes * kBlock;
   // Targets padded to whole tiles with copies of the last one (their results are dropped).
   const int ntiles = (t.n + W - 1) / W, padded = ntiles * W;
-  std::vector<float> tx(static_cast<std::size_t>(padded)), ty(tx.size()), tz(tx.size());
+  // The float copies live on between calls (one set per calling thread): a run calls this thousands of times
+  // with the same sizes, so after the first call nothing is allocated.
+  thread_local std::vector<float> tx, ty, tz;
+  thread_local FloatSoA f;
+  tx.resize(static_cast<std::size_t>(padded));
+  ty.resize(tx.size());
+  tz.resize(tx.size());
   for (int i = 0; i < padded; ++i) {
     const int k = std::min(i, t.n - 1);
     tx[i] = static_cast<float>(t.x[k]);
     ty[i] = static_cast<float>(t.y[k]);
     tz[i] = static_cast<float>(t.z[k]);
   }
-  FloatSoA f;
   to_float(s.x, s.n, f.x);
   to_float(s.y, s.n, f.y);
   to_float(s.z, s.n, f.z);
   to_float(s.qx, s.n, f.qx);
   to_float(s.qy, s.n, f.qy);
   to_float(s.qz, s.n, f.qz);
+  // The OpenMP threads must see this thread's copies, not their own thread_local ones: plain locals.
+  const FloatSoA& src = f;
+  const float *px = tx.data(), *py = ty.data(), *pz = tz.data();
 #pragma omp parallel for schedule(static)
   for (int it = 0; it < ntiles; ++it) {
     const int i0 = it * W;
     alignas(64) double ox[W], oy[W], oz[W];
-    tile(tx.data() + i0, ty.data() + i0, tz.data() + i0, f, s.n, ox, oy, oz);
+    tile(px + i0, py + i0, pz + i0, src, s.n, ox, oy, oz);
     for (int l = 0; l < W && i0 + l < t.n; ++l) {
       u.x[i0 + l] = ox[l];
       u.y[i0 + l] = oy[l];

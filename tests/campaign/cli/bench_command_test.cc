@@ -2,6 +2,10 @@
 // with exit code 2. Times are not asserted (they depend on the machine); only their consistency is.
 #include <gtest/gtest.h>
 
+#include <string>
+#include <utility>
+#include <vector>
+
 #include <nlohmann/json.hpp>
 
 #include "tests/campaign/test_util.h"
@@ -50,6 +54,15 @@ TEST(BenchFlow, BadOptionsExitTwoWithOneMessage) {
     EXPECT_NE(r.err.find("capsim bench"), std::string::npos) << args << ": " << r.err;
   }
   EXPECT_EQ(sh(exe() + " bench nosuch").code, 2);
+  // Case keys are checked by the key registry: the message names the key.
+  for (const auto& [args, key] : std::vector<std::pair<std::string, std::string>>{
+           {"--precision half", "numerics.kernel_precision"},
+           {"--bending -1", "capsule.bending_modulus"},
+           {"--level 9", "mesh.level"}}) {
+    const CmdResult r = sh(exe() + " bench flow " + args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_NE(r.err.find(key), std::string::npos) << args << ": " << r.err;
+  }
 }
 
 }  // namespace

@@ -154,6 +154,46 @@ TEST(CaseDriver, ResumedRunBlowsUpAsTheUninterruptedRun) {
   }
 }
 
+// A checkpoint written before a key joined the registry lacks that key's line in its stored case; it must
+// still resume (the key takes its default), while a checkpoint of another case is refused. This broke once:
+// the level-4 wrinkle run's checkpoint predates numerics.kernel_precision and was refused.
+TEST(CaseDriver, CheckpointWithoutALaterKeyResumesAndAnotherCaseIsRefused) {
+  const config::CaseConfig c = growing_instability();
+  const CaseResult full = run_case(c, quiet_in(scratch("resume_oldkey_full")));
+  const auto dir = scratch("resume_oldkey");
+  RunOptions o = quiet_in(dir);
+  o.stop_after_steps = full.steps / 2;
+  ASSERT_EQ(run_case(c, o).status, "interrupted");
+  const fs::path file = dir / io::kCheckpointFileName;
+  io::Checkpoint cp = io::read_checkpoint(file);
+  std::string& stored = cp.strings["case"];
+  const auto at = stored.find("kernel_precision = ");
+  ASSERT_NE(at, std::string::npos) << stored;
+  stored.erase(at, stored.find('\n', at) + 1 - at);  // as written before the key existed
+  io::write_checkpoint(file, cp);
+  o.stop_after_steps = 0;
+  o.resume = true;
+  const CaseResult resumed = run_case(c, o);
+  EXPECT_EQ(resumed.status, full.status) << resumed.reason;
+  EXPECT_EQ(resumed.steps, full.steps);
+
+  // Another value of a key that is written: refused, with a message naming the checkpoint.
+  const auto other_dir = scratch("resume_othercase");
+  RunOptions p = quiet_in(other_dir);
+  p.stop_after_steps = full.steps / 2;
+  ASSERT_EQ(run_case(c, p).status, "interrupted");
+  config::CaseConfig other = c;
+  other.capillary_number = 0.06;
+  p.stop_after_steps = 0;
+  p.resume = true;
+  try {
+    run_case(other, p);
+    ADD_FAILURE() << "a checkpoint of another case was resumed";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("another case"), std::string::npos) << e.what();
+  }
+}
+
 double volume_of(const config::CaseConfig& c, const Eigen::Matrix3Xd& x) {
   const auto mesh = mesh::make_capsule_mesh(c.level, c.aspect_ratio, mesh::parse_spheroid_map(c.spheroid_map));
   return membrane::area_and_volume(mesh, x).volume;

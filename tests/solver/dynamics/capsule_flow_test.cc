@@ -22,15 +22,21 @@ config::CaseConfig sphere_case(int level, double Ca) {
   return c;
 }
 
+// The reference stretched by 15 % along x1 at constant volume (x2, x3 shrunk by 1/√1.15): a loaded membrane
+// that keeps the mirror symmetry.
+Eigen::Matrix3Xd stretched(Eigen::Matrix3Xd x) {
+  x.row(0) *= 1.15;
+  x.row(1) /= std::sqrt(1.15);
+  x.row(2) /= std::sqrt(1.15);
+  return x;
+}
+
 // Sign of the coupling (solver/README.md §3): a capsule stretched away from its reference shape in fluid at rest
 // must relax back, its elastic energy decreasing monotonically towards zero.
 TEST(CapsuleFlow, StretchedCapsuleRelaxesInFluidAtRest) {
   CapsuleFlow flow(sphere_case(2, 0.1));
   flow.set_background_flow(false);
-  Eigen::Matrix3Xd x = flow.reference();
-  x.row(0) *= 1.15;
-  x.row(1) /= std::sqrt(1.15);
-  x.row(2) /= std::sqrt(1.15);
+  Eigen::Matrix3Xd x = stretched(flow.reference());
   const double dt = automatic_time_step(flow.mesh(), 0.1, 0.2);
   Rk2Integrator rk;
   double energy = flow.mechanics().energy(x);
@@ -68,10 +74,7 @@ TEST(CapsuleFlow, FarFieldKeysReachTheBoundaryIntegral) {
   CapsuleFlow on(c);
   off.set_background_flow(false);
   on.set_background_flow(false);
-  Eigen::Matrix3Xd x = off.reference();
-  x.row(0) *= 1.15;
-  x.row(1) /= std::sqrt(1.15);
-  x.row(2) /= std::sqrt(1.15);
+  const Eigen::Matrix3Xd x = stretched(off.reference());
   Eigen::Matrix3Xd v_off, v_on;
   off.velocity(x, v_off);
   on.velocity(x, v_on);
@@ -93,10 +96,7 @@ TEST(CapsuleFlow, MixedPrecisionKeepsTheSymmetricEvaluation) {
   CapsuleFlow dbl(c);
   c.kernel_precision = "mixed";
   CapsuleFlow mix(c);
-  Eigen::Matrix3Xd x = mix.reference(), v, vd;
-  x.row(0) *= 1.15;  // stretched (and still mirror-symmetric): the membrane is loaded
-  x.row(1) /= std::sqrt(1.15);
-  x.row(2) /= std::sqrt(1.15);
+  Eigen::Matrix3Xd x = stretched(mix.reference()), v, vd;  // still mirror-symmetric, the membrane loaded
   mix.velocity(x, v);
   dbl.velocity(x, vd);
   const double rel = (v - vd).cwiseAbs().maxCoeff() / vd.cwiseAbs().maxCoeff();

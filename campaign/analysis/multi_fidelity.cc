@@ -36,12 +36,15 @@ struct Proposals {
 };
 
 // Appends the cases of `ca` (template `base`, at `level`) within the budget; false once it is spent.
-bool emit(const CaseParams& base, int level, const std::vector<double>& ca, std::vector<CaseParams>& out, int& budget) {
+// `precision`: numerics.kernel_precision of the new cases ("": the base case's).
+bool emit(const CaseParams& base, int level, const std::vector<double>& ca, std::vector<CaseParams>& out, int& budget,
+          const std::string& precision = "") {
   for (double x : ca) {
     if (budget <= 0) return false;
     CaseParams p = base;
     p.set("mesh.level", std::int64_t{level});
     p.set("flow.capillary_number", x);
+    if (!precision.empty()) p.set("numerics.kernel_precision", precision);
     out.push_back(std::move(p));
     --budget;
   }
@@ -242,7 +245,7 @@ std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups
       outwards(false, t.ca_star_below, t.ca_star_low);
       outwards(false, t.ca_star_high, t.ca_star_above);
     }
-    if (!emit(answer.base, o.levels[2], p.ca, out, budget)) break;
+    if (!emit(answer.base, o.levels[2], p.ca, out, budget, o.check_precision)) break;
   }
   return out;
 }

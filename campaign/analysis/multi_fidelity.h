@@ -31,6 +31,7 @@
 /// (the refinement); 6 runs last (the cheap dt check first, so that a campaign interrupted among the check
 /// level's long cases has it). The mesh part is not waited for: on a third level it costs hours.
 
+#include <string>
 #include <vector>
 
 #include "campaign/analysis/transitions.h"
@@ -46,6 +47,7 @@ struct MultiFidelityOptions {
   double ca_tolerance = 0.005;  ///< smallest bracket adaptive mode makes
   bool adaptive = false;        ///< phase 4
   bool dt_check = false;        ///< phase 5 will run: phase 4 waits for each cell's dt check
+  std::string check_precision;  ///< numerics.kernel_precision of phase 6's new cases ("": the answer case's)
 };
 
 /// @brief Phases 2–4: the cases of one round on the answer level (none: the answer level is done). New cases
@@ -59,7 +61,8 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
 /// saved"). 0 for a missing bracket.
 int bisections_saved(const Transition& t, double ca_tolerance);
 
-/// @brief Phase 6: the final brackets of the answer level on the check level (levels[2]; none without one).
+/// @brief Phase 6: the final brackets of the answer level on the check level (levels[2]; none without one),
+/// in o.check_precision where set. A Ca the check group has in any precision is not proposed again.
 std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,
                                           int budget);
 

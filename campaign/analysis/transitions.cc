@@ -5,7 +5,9 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <variant>
 
+#include "campaign/analysis/refinement.h"
 #include "campaign/grid/decimal.h"
 #include "campaign/grid/precision.h"
 
@@ -112,7 +114,9 @@ std::string group_key(const CaseParams& params) {
     const auto eq = line.find('=');
     if (eq == std::string::npos) continue;
     const std::string k = line.substr(0, eq), v = line.substr(eq + 1);
-    if (k == "flow.capillary_number") continue;
+    // Ca varies within a group; the kernel precision is how a case was computed, not what (both precisions
+    // of a case answer the same question to ~1e-6): a check level run in mixed precision joins its group.
+    if (k == "flow.capillary_number" || k == "numerics.kernel_precision") continue;
     auto parsed = nlohmann::json::parse(v, nullptr, false);
     j[k] = (!parsed.is_discarded() && (parsed.is_number() || parsed.is_boolean() || parsed.is_string()))
                ? parsed
@@ -136,6 +140,7 @@ std::string group_difference(const std::string& a, const std::string& b) {
 
 std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases) {
   std::map<std::string, std::size_t> index;
+  std::map<std::size_t, std::vector<double>> double_ca;  // per group: the Ca whose sample is a double case
   std::vector<SampleGroup> out;
   for (const auto& c : cases) {
     const std::string key = group_key(c.params);
@@ -151,10 +156,24 @@ std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases) {
       out.push_back(std::move(g));
     }
     SampleGroup& g = out[it->second];
-    g.case_ca.push_back(c.params.capillary_number());
-    if (c.status == "done")
-      g.samples.push_back({c.params.capillary_number(), c.min_d12, c.max_tau_min, c.case_id, c.min_d12_spread,
-                           c.max_tau_min_spread, c.dt});
+    const double ca = c.params.capillary_number();
+    g.case_ca.push_back(ca);
+    if (c.status != "done") continue;
+    const Sample sample{ca, c.min_d12, c.max_tau_min, c.case_id, c.min_d12_spread, c.max_tau_min_spread, c.dt};
+    // One sample per Ca: where a Ca was run in both precisions, the double one (the reference) is used.
+    const auto& values = c.params.values();
+    const auto precision = values.find("numerics.kernel_precision");
+    const std::string* text = precision == values.end() ? nullptr : std::get_if<std::string>(&precision->second);
+    const bool is_double = !text || *text == "double";
+    const auto same = std::find_if(g.samples.begin(), g.samples.end(), [&](const Sample& s) { return same_ca(s.ca, ca); });
+    if (same == g.samples.end()) {
+      g.samples.push_back(sample);
+      if (is_double) double_ca[it->second].push_back(ca);
+    } else if (is_double && std::none_of(double_ca[it->second].begin(), double_ca[it->second].end(),
+                                         [&](double x) { return same_ca(x, ca); })) {
+      *same = sample;
+      double_ca[it->second].push_back(ca);
+    }
   }
   return out;
 }

@@ -94,7 +94,8 @@ struct SampleGroup {
   CaseParams base;                      ///< one case of the group: the template of new cases
 };
 
-/// @brief The group key of a case: canonical JSON of its identity keys except Ca (see Transition::group_key).
+/// @brief The group key of a case: canonical JSON of its identity keys except Ca and numerics.kernel_precision
+/// (how a case was computed, not what: both precisions agree to ~1e-6 in min D12, results/speed/mixed_ab_case.json).
 std::string group_key(const CaseParams& params);
 
 /// @brief The keys in which two group keys differ, as "key (a vs b), ..." (for messages); "" if equal or
@@ -102,7 +103,9 @@ std::string group_key(const CaseParams& params);
 std::string group_difference(const std::string& group_key_a, const std::string& group_key_b);
 
 /// @brief Groups cases by group_key (groups in order of first appearance); a group with no done case is
-/// still listed (empty samples). @throws capsim::config::ConfigError for a case the solver rejects.
+/// still listed (empty samples). Cases that differ in numerics.kernel_precision only share a group (see
+/// group_key); a Ca done in both precisions gives one sample, the double one. @throws
+/// capsim::config::ConfigError for a case the solver rejects.
 std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases);
 
 /// @brief Computes the transition row of one group from its samples (any order; status done only).

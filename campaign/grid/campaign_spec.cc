@@ -204,7 +204,8 @@ CampaignSpec parse_campaign(const std::string& text, const std::string& source) 
   if (auto* a = root.get("analysis")) {
     if (!a->is_table()) fail(source, "[analysis]", "expected a table");
     const auto& at = *a->as_table();
-    expect_only(at, {"D12_threshold", "adaptive", "ca_tolerance", "max_cases", "max_rounds", "levels", "dt_check"},
+    expect_only(at, {"D12_threshold", "adaptive", "ca_tolerance", "max_cases", "max_rounds", "levels", "dt_check",
+                     "check_precision"},
                 source, "[analysis]");
     auto number = [&](const char* k, double& out, double lo, double hi) {
       if (auto* n = at.get(k)) {
@@ -266,6 +267,16 @@ CampaignSpec parse_campaign(const std::string& text, const std::string& source) 
         fail(source, "[analysis] dt_check", "needs [analysis] levels (it re-runs a case of the answer level)");
       spec.analysis.dt_check = *b;
     }
+    if (auto* n = at.get("check_precision")) {
+      auto v = n->value_exact<std::string>();
+      if (!v) fail(source, "[analysis] check_precision", "expected a string, got " + toml_type_name(*n));
+      if (spec.analysis.levels.size() != 3)
+        fail(source, "[analysis] check_precision", "needs a check level ([analysis] levels = [scan, answer, check])");
+      // Its values are those of the case key it sets (the key registry).
+      if (const std::string why = check_case_value(*find_case_key("numerics.kernel_precision"), Value{*v}); !why.empty())
+        fail(source, "[analysis] check_precision", why);
+      spec.analysis.check_precision = *v;
+    }
   }
   return spec;
 }
@@ -301,6 +312,7 @@ std::string CampaignSpec::to_json() const {
     j["analysis"]["levels"] = analysis.levels;
     j["analysis"]["dt_check"] = analysis.dt_check;
   }
+  if (!analysis.check_precision.empty()) j["analysis"]["check_precision"] = analysis.check_precision;
   return j.dump();
 }
 

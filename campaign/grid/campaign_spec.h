@@ -33,6 +33,11 @@ struct AnalysisSpec {
   /// check level re-runs the final brackets for the mesh error (campaign/README.md, "Multi-fidelity").
   std::vector<int> levels;
   bool dt_check = false;        ///< re-run one bracketing case per cell with dt/2 (the time-step error)
+  /// @brief numerics.kernel_precision of the check level's cases ("": the campaign's, as every other level).
+  /// "mixed" halves the cost of a level-4 case (results/benchmarks.md, "Mixed precision") for a change of
+  /// ~1e-6 in its answers, far below the level 3 → 4 differences it measures. A case's precision says how it
+  /// was computed, not what: the analysis puts both precisions of a group into one (transitions.h group_key).
+  std::string check_precision;
 };
 
 /// @brief A validated campaign.

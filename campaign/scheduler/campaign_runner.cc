@@ -311,7 +311,7 @@ int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& 
     // The phases of analysis/multi_fidelity.h, the first that has something to add.
     const auto& lv = spec.analysis.levels;
     const MultiFidelityOptions mf{lv, spec.analysis.d12_threshold, spec.analysis.ca_tolerance, spec.analysis.adaptive,
-                                  spec.analysis.dt_check};
+                                  spec.analysis.dt_check, spec.analysis.check_precision};
     add = answer_level_round(groups, mf, budget);
     phase = "multi-fidelity: level " + std::to_string(lv[1]) + " (seed, re-bracket" +
             (spec.analysis.adaptive ? ", refine)" : ")");

@@ -7,6 +7,10 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <string>
+#include <variant>
+
+#include "campaign/analysis/refinement.h"
 
 namespace capsim::campaign {
 namespace {
@@ -217,6 +221,50 @@ TEST(MultiFidelity, TheCheckLevelRunsTheFinalBrackets) {
   cases.push_back(fake(4, 0.55, tau3, "queued"));
   EXPECT_EQ(ca_at(check_level_cases(group_cases(cases), o, 100), 4), (std::vector<double>{0.65}));
   EXPECT_TRUE(check_level_cases(group_cases(cases), o, 0).empty()) << "no budget";
+}
+
+// [analysis] check_precision = "mixed": the check level's new cases carry it, and a check case in either
+// precision counts as the check level's sample at its Ca (one group: group_key leaves the precision out).
+// Where a Ca was done in both precisions the double sample is the one used.
+TEST(MultiFidelity, TheCheckLevelInMixedPrecisionJoinsTheDoubleGroup) {
+  const auto mixed = [](CaseSample c) {
+    c.params.set("numerics.kernel_precision", std::string("mixed"));
+    c.case_id += "-mixed";
+    return c;
+  };
+  std::vector<CaseSample> cases;
+  for (double ca : {0.1, 0.2, 0.5, 1.0}) cases.push_back(fake(2, ca, tau2));
+  for (double ca : {0.1, 0.55, 0.65, 1.0}) cases.push_back(fake(3, ca, tau3));
+  MultiFidelityOptions o = kOptions;
+  o.levels = {2, 3, 4};
+  o.check_precision = "mixed";
+  const auto add = check_level_cases(group_cases(cases), o, 100);
+  ASSERT_EQ(ca_at(add, 4), (std::vector<double>{0.55, 0.65}));
+  for (const auto& p : add) {
+    ASSERT_TRUE(p.values().contains("numerics.kernel_precision"));
+    EXPECT_EQ(std::get<std::string>(p.values().at("numerics.kernel_precision")), "mixed");
+  }
+  // A double level-4 case at 0.55 (say from before the option) and a mixed one at 0.65: one level-4 group,
+  // nothing more to run.
+  cases.push_back(fake(4, 0.55, tau3));
+  cases.push_back(mixed(fake(4, 0.65, tau3)));
+  const auto groups = group_cases(cases);
+  EXPECT_EQ(std::count_if(groups.begin(), groups.end(), [](const SampleGroup& g) { return g.key.mesh_level == 4; }), 1);
+  EXPECT_TRUE(check_level_cases(groups, o, 100).empty());
+  // Both precisions done at one Ca: one sample, the double one, whichever comes first.
+  for (const bool double_first : {true, false}) {
+    std::vector<CaseSample> both = cases;
+    CaseSample d = fake(4, 0.65, [](double) { return -1.0; }), m = mixed(fake(4, 0.65, [](double) { return 1.0; }));
+    both.pop_back();
+    both.push_back(double_first ? d : m);
+    both.push_back(double_first ? m : d);
+    for (const auto& g : group_cases(both))
+      if (g.key.mesh_level == 4) {
+        ASSERT_EQ(g.samples.size(), 2u) << "one sample per Ca";
+        for (const auto& smp : g.samples)
+          if (same_ca(smp.ca, 0.65)) EXPECT_EQ(*smp.max_tau_min, -1.0) << "the double sample, double first " << double_first;
+      }
+  }
 }
 
 // Where the check level's values at the final bracket lie on one side of 0 (its CaH is outside the bracket),

@@ -229,6 +229,14 @@ TEST(Grid, MultiFidelityLevelsSetTheScanLevel) {
   bad(head + "levels = [2, 9]\n", "out of range");
   bad(head + "levels = [2, 3.5]\n", "integers");
   bad(head + "dt_check = true\n", "needs [analysis] levels");
+  // check_precision: the check level's numerics.kernel_precision, values from the key registry.
+  const auto mixed = parse_campaign(head + "levels = [2, 3, 4]\ncheck_precision = 'mixed'\n", "mf.toml");
+  EXPECT_EQ(mixed.analysis.check_precision, "mixed");
+  EXPECT_NE(mixed.to_json().find("\"check_precision\":\"mixed\""), std::string::npos) << mixed.to_json();
+  EXPECT_EQ(spec.to_json().find("check_precision"), std::string::npos) << "stored only when set";
+  bad(head + "levels = [2, 3]\ncheck_precision = 'mixed'\n", "needs a check level");
+  bad(head + "levels = [2, 3, 4]\ncheck_precision = 'half'\n", "check_precision");
+  bad(head + "levels = [2, 3, 4]\ncheck_precision = 1\n", "expected a string");
   bad("[campaign]\nname='mf'\n[defaults]\nmesh.level = 3\n[[grid]]\ncapillary_number=[0.1]\n[analysis]\nlevels = [2, 3]\n",
       "[defaults] mesh.level");
   bad("[campaign]\nname='mf'\n[[grid]]\ncapillary_number=[0.1]\nmesh_level=[2]\n[analysis]\nlevels = [2, 3]\n",

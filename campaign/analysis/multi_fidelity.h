@@ -66,6 +66,16 @@ int bisections_saved(const Transition& t, double ca_tolerance);
 std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,
                                           int budget);
 
+/// @brief Phase 6 while other cases still run (the scheduler's top-up when a worker is free and nothing is
+/// queued): check_level_cases, but only once nothing still running can change what it proposes — every
+/// running case is on the check level (@p running_levels: the mesh levels of the running cases) and phases
+/// 2–5 add nothing, exactly the state in which the rounds would have moved on to phase 6. Else none. Why:
+/// the rounds are sequential, so one check-level case of hours kept every other worker idle until it ended
+/// while other cells' check cases were known and waiting (the certified Table 1, 2026-12-05).
+std::vector<CaseParams> check_level_cases_while_running(const std::vector<SampleGroup>& groups,
+                                                        const MultiFidelityOptions& o,
+                                                        const std::vector<int>& running_levels, int budget);
+
 /// @brief Phase 5: per cell, the CaH-low case of the answer level (else its Ca*-low case) with time.dt set
 /// to half the step it ran with; none in a cell that has a dt check case already (any Ca, any status).
 std::vector<CaseParams> dt_check_cases(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,

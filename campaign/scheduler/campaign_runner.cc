@@ -87,38 +87,28 @@ class Runner {
         runs_dir_(std::move(runs_dir)), worker_(opt.worker.empty() ? default_worker_executable() : opt.worker),
         host_(host_name()) {}
 
-  /// Runs every queued case of the campaign; returns false if stopped by a signal.
+  /// What a free worker may still start when nothing is queued and other cases run: called with the mesh
+  /// levels of the running cases, returns how many cases it added to the campaign (refine_campaign's top-up).
+  using TopUp = std::function<int(const std::vector<int>& running_levels)>;
+  void set_top_up(TopUp top_up) { top_up_ = std::move(top_up); }
+
+  /// Runs every queued case of the campaign (and what the top-up adds meanwhile); returns false if stopped
+  /// by a signal.
   bool run_queued() {
     learn_costs();
     auto rows = store_.campaign_cases(campaign_id_);
     std::vector<CaseRow> pending;
     for (auto& r : rows)
       if (r.status == "queued" && !interrupted_.count(r.case_id)) pending.push_back(r);
-    // longest first keeps the workers busy to the end of a campaign that finishes (the long cases do not
-    // start last); shortest first completes the most answers per hour of one that will be interrupted.
-    // Both by the work left: a case that resumes from a checkpoint at γ̇t = 30 of 40 is a quarter of a case
-    // (an interrupted level-4 case is then finished first by `--order shortest`, not left behind whole ones).
-    if (opt_.order == "longest" || opt_.order == "shortest") {
-      // The whole case as the ETA predicts it (wall ∝ est^β per level), the estimate itself before any finished.
-      std::map<std::string, double> left;
-      for (const auto& r : pending) {
-        const double whole = eta_.expected_s(r.params.mesh_level(), r.est_cost);
-        left[r.case_id] = (whole >= 0 ? whole : r.est_cost) *
-                          (r.resumable ? work_fraction_left(r.out_dir, r.params.t_end()) : 1.0);
-      }
-      const bool longest = opt_.order == "longest";
-      std::stable_sort(pending.begin(), pending.end(), [&](const CaseRow& a, const CaseRow& b) {
-        return longest ? left[a.case_id] > left[b.case_id] : left[a.case_id] < left[b.case_id];
-      });
-    }
+    order(pending);
     total_ = static_cast<int>(rows.size());
     finished_ = failed_ = 0;
     for (auto& r : rows) {
       if (r.status == "done" || r.status == "unstable") ++finished_;
       if (r.status == "failed") ++failed_;
     }
-    std::reverse(pending.begin(), pending.end());  // pop_back = next case
     bool forwarded = false;
+    bool top_up_due = true;  // asked again each time a worker ends (new results may let it add cases)
     std::chrono::steady_clock::time_point kill_deadline{};
     while (!pending.empty() || !running_.empty()) {
       if (g_stop_signal && !forwarded) {
@@ -132,7 +122,25 @@ class Runner {
       if (forwarded && (g_stop_count > 1 || std::chrono::steady_clock::now() > kill_deadline)) {
         for (auto& [pid, _] : running_) kill(-pid, SIGKILL);
       }
+      const std::size_t before = running_.size();
       reap();
+      top_up_due |= running_.size() < before;
+      if (top_up_ && top_up_due && !g_stop_signal && pending.empty() && !running_.empty() &&
+          static_cast<int>(running_.size()) < jobs_) {
+        top_up_due = false;
+        std::vector<int> levels;
+        for (const auto& [_, r] : running_) levels.push_back(r.row.params.mesh_level());
+        if (top_up_(levels) > 0) {
+          rows = store_.campaign_cases(campaign_id_);
+          std::set<std::string> running_ids;
+          for (const auto& [_, r] : running_) running_ids.insert(r.row.case_id);
+          for (auto& r : rows)
+            if (r.status == "queued" && !interrupted_.count(r.case_id) && !running_ids.count(r.case_id))
+              pending.push_back(r);
+          order(pending);
+          total_ = static_cast<int>(rows.size());
+        }
+      }
       while (!g_stop_signal && static_cast<int>(running_.size()) < jobs_ && !pending.empty()) {
         CaseRow row = std::move(pending.back());
         pending.pop_back();
@@ -154,6 +162,28 @@ class Runner {
   int interrupted() const { return static_cast<int>(interrupted_.size()); }
 
  private:
+  // The queue in the order of --order, the next case last (pop_back).
+  void order(std::vector<CaseRow>& pending) {
+    // longest first keeps the workers busy to the end of a campaign that finishes (the long cases do not
+    // start last); shortest first completes the most answers per hour of one that will be interrupted.
+    // Both by the work left: a case that resumes from a checkpoint at γ̇t = 30 of 40 is a quarter of a case
+    // (an interrupted level-4 case is then finished first by `--order shortest`, not left behind whole ones).
+    if (opt_.order == "longest" || opt_.order == "shortest") {
+      // The whole case as the ETA predicts it (wall ∝ est^β per level), the estimate itself before any finished.
+      std::map<std::string, double> left;
+      for (const auto& r : pending) {
+        const double whole = eta_.expected_s(r.params.mesh_level(), r.est_cost);
+        left[r.case_id] = (whole >= 0 ? whole : r.est_cost) *
+                          (r.resumable ? work_fraction_left(r.out_dir, r.params.t_end()) : 1.0);
+      }
+      const bool longest = opt_.order == "longest";
+      std::stable_sort(pending.begin(), pending.end(), [&](const CaseRow& a, const CaseRow& b) {
+        return longest ? left[a.case_id] > left[b.case_id] : left[a.case_id] < left[b.case_id];
+      });
+    }
+    std::reverse(pending.begin(), pending.end());  // pop_back = next case
+  }
+
   ProgressCounts counts(const std::vector<CaseRow>& pending) const {
     ProgressCounts c;
     c.total = total_;
@@ -244,6 +274,7 @@ class Runner {
   std::set<std::string> interrupted_;
   int total_ = 0, finished_ = 0, failed_ = 0, queued_ = 0;
   EtaModel eta_;  // per mesh level, wall seconds against estimated cost of the campaign's finished cases
+  TopUp top_up_;  // empty: the queue is all there is until run_queued returns
 };
 
 /// After a manager crash: stop leftover workers, then ingest finished results or requeue.
@@ -302,7 +333,7 @@ bool reanalyse_campaign(Store& store, std::int64_t campaign_id) {
 }
 
 int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir,
-                    std::string* what) {
+                    std::string* what, const std::vector<int>* running_levels) {
   const int budget = spec.analysis.max_cases - store.count_campaign_cases(campaign_id, "adaptive");
   const auto groups = group_cases(store.campaign_samples(campaign_id));
   std::vector<CaseParams> add;
@@ -312,6 +343,15 @@ int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& 
     const auto& lv = spec.analysis.levels;
     const MultiFidelityOptions mf{lv, spec.analysis.d12_threshold, spec.analysis.ca_tolerance, spec.analysis.adaptive,
                                   spec.analysis.dt_check, spec.analysis.check_precision};
+    if (running_levels) {  // a top-up while cases run: the check level only, once nothing running can change it
+      if (what) *what = "multi-fidelity: mesh check on level " + std::to_string(lv.back());
+      add = check_level_cases_while_running(groups, mf, *running_levels, budget);
+      if (add.empty()) return 0;
+      Transaction t(store.db());
+      const int added = store.add_cases(campaign_id, add, "adaptive", runs_dir);
+      t.commit();
+      return added;
+    }
     add = answer_level_round(groups, mf, budget);
     phase = "multi-fidelity: level " + std::to_string(lv[1]) + " (seed, re-bracket" +
             (spec.analysis.adaptive ? ", refine)" : ")");
@@ -509,6 +549,17 @@ int run_campaign(const RunOptions& opt, const BeforeRun& before_run) {
   runner.message("capsim campaign: '" + spec.name + "': " + std::to_string(cases.size()) + " grid cases, " +
                  std::to_string(jobs) + " job(s) x " + std::to_string(threads) + " thread(s), database " + opt.db_path);
 
+  // With a check level, a worker left without a queued case while another runs (a level-4 case takes hours)
+  // takes the check level's cases that nothing running can change, instead of waiting for the round to end.
+  if (spec.analysis.levels.size() > 2)
+    runner.set_top_up([&](const std::vector<int>& running_levels) {
+      std::string what;
+      const int added = refine_campaign(*store, campaign_id, spec, runs_dir, &what, &running_levels);
+      if (added > 0)
+        runner.message("capsim campaign: " + what + ", while " + std::to_string(running_levels.size()) +
+                       " case(s) run: " + std::to_string(added) + " case(s) added");
+      return added;
+    });
   bool completed = runner.run_queued();
   const std::string method = analysis_method(spec.analysis.adaptive, !spec.analysis.levels.empty());
   if (completed && (spec.analysis.adaptive || !spec.analysis.levels.empty())) {

@@ -18,6 +18,7 @@
 # Faults, chosen by Ca (comma-separated lists, exact text as written in the case file):
 #   FAKE_CRASH_CA: SIGSEGV itself; FAKE_FAIL_CA: exit 1 with a message; FAKE_UNSTABLE_CA: status unstable;
 #   FAKE_BADINPUT_CA: exit 2. FAKE_LOG: append "done <DIR>" when a case completes.
+# Slow cases: FAKE_SLOW_CA (list) on mesh level FAKE_SLOW_LEVEL (any if unset) take FAKE_SLOW_STEP_S (1 s) per step.
 set -u
 [ "${1:-}" = "run" ] || { echo "fake_worker: expected 'run'" >&2; exit 2; }
 shift
@@ -61,6 +62,7 @@ in_list() { local v="$1" list="$2" x; IFS=',' read -ra xs <<< "$list"; for x in 
 
 steps=${FAKE_STEPS:-4}
 step_s=${FAKE_STEP_S:-0.05}
+in_list "$ca" "${FAKE_SLOW_CA:-}" && [ "$level" = "${FAKE_SLOW_LEVEL:-$level}" ] && step_s=${FAKE_SLOW_STEP_S:-1}
 step=0
 if [ $resume = 1 ]; then
   [ -f "$out/checkpoint.txt" ] || { echo "fake_worker: --resume but no checkpoint in $out" >&2; exit 2; }

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "tests/campaign/test_util.h"
@@ -144,6 +146,52 @@ max_rounds = 20
   r = sh(table1 + " --db " + dir + "/three.db --error-check " + dir + "/two.json");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("capsim campaign analyse"), std::string::npos) << r.err;
+}
+
+// Rounds are sequential, so a worker left without a queued case used to wait for the round's last case — on
+// the certified Table 1 a level-4 case of hours. With a check level the free worker now takes the check
+// level's cases that nothing running can change (analysis/multi_fidelity.h, check_level_cases_while_running).
+// Fake CaH of level L = 0.70 − 0.08 · 2^-L: level 3's CaH lies above level 2's final bracket, so the check
+// level's second round runs the answer level's next sample outwards (0.8). With the Ca* check case at 0.015
+// slow, that case starts while 0.015 still runs; the cases and the answers are those of the plain run.
+TEST(MultiFidelity, AFreeWorkerTakesTheCheckLevelsNextCaseWhileALongOneRuns) {
+  const std::string dir = fresh_dir("multi_fidelity_top_up");
+  write_file(dir + "/mf.toml", R"([campaign]
+name = "mf"
+[[grid]]
+aspect_ratio = [0.5]
+law = ["neo-hookean"]
+capillary_number = [0.01, 0.02, 0.03, 0.04, 0.05, 0.1, 0.4, 0.8, 1.2]
+[analysis]
+levels = [1, 2, 3]
+adaptive = true
+ca_tolerance = 0.005
+max_rounds = 20
+)");
+  const std::string env = "FAKE_STEPS=1 FAKE_STEP_S=0.001 FAKE_LEVEL_SHIFT=0.08";
+  auto level3 = [&](const std::string& db) {
+    return sh(exe() + " query sql \"SELECT capillary_number AS ca, started_at, finished_at FROM cases WHERE mesh_level = 3 "
+                      "ORDER BY capillary_number\" --db " + db + " --format json").out;
+  };
+  auto r = sh(campaign_cmd(env, dir + "/mf.toml", dir + "/plain.db", "--jobs 2"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto plain = nlohmann::json::parse(level3(dir + "/plain.db"));
+  std::vector<double> plain_ca;
+  for (const auto& c : plain) plain_ca.push_back(c["ca"]);
+  // The scenario the test needs: 0.015 in the first check round, 0.8 the outwards case of the second.
+  ASSERT_EQ(plain_ca, (std::vector<double>{0.015, 0.018, 0.04, 0.045, 0.663, 0.68, 0.8})) << r.err;
+  ASSERT_NE(r.err.find("round 6, multi-fidelity: mesh check on level 3: 1 case(s) added"), std::string::npos) << r.err;
+
+  r = sh(campaign_cmd(env + " FAKE_SLOW_CA=0.015 FAKE_SLOW_LEVEL=3 FAKE_SLOW_STEP_S=3", dir + "/mf.toml",
+                      dir + "/top_up.db", "--jobs 2"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("mesh check on level 3, while 1 case(s) run: 1 case(s) added"), std::string::npos) << r.err;
+  const auto top_up = nlohmann::json::parse(level3(dir + "/top_up.db"));
+  ASSERT_EQ(top_up.size(), plain.size());
+  EXPECT_LT(top_up[6]["started_at"].get<std::string>(), top_up[0]["finished_at"].get<std::string>())
+      << "0.8 starts while 0.015 runs: " << top_up.dump();
+  auto table = [&](const std::string& db) { return sh(exe() + " query table1 --db " + db + " --format json").out; };
+  EXPECT_EQ(table(dir + "/top_up.db"), table(dir + "/plain.db"));
 }
 
 }  // namespace

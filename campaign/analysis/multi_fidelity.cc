@@ -250,17 +250,9 @@ std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups
   return out;
 }
 
-std::vector<CaseParams> check_level_cases_while_running(const std::vector<SampleGroup>& groups,
-                                                        const MultiFidelityOptions& o,
-                                                        const std::vector<int>& running_levels, int budget) {
-  if (o.levels.size() < 3 || budget <= 0) return {};
-  // A running case of another level may still move a bracket (answer level) or a dt part: wait for it.
-  for (const int level : running_levels)
-    if (level != o.levels[2]) return {};
-  // The phases before 6, in the order the rounds take them: while one would add a case, phase 6 waits.
-  if (!answer_level_round(groups, o, budget).empty()) return {};
-  if (o.dt_check && !dt_check_cases(groups, o, budget).empty()) return {};
-  return check_level_cases(groups, o, budget);
+bool rounds_may_overlap(const MultiFidelityOptions& o, const std::vector<int>& running_levels) {
+  if (o.levels.size() < 3) return false;
+  return std::all_of(running_levels.begin(), running_levels.end(), [&](int level) { return level == o.levels[2]; });
 }
 
 std::vector<CaseParams> dt_check_cases(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,

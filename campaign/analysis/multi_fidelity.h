@@ -66,15 +66,15 @@ int bisections_saved(const Transition& t, double ca_tolerance);
 std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,
                                           int budget);
 
-/// @brief Phase 6 while other cases still run (the scheduler's top-up when a worker is free and nothing is
-/// queued): check_level_cases, but only once nothing still running can change what it proposes — every
-/// running case is on the check level (@p running_levels: the mesh levels of the running cases) and phases
-/// 2–5 add nothing, exactly the state in which the rounds would have moved on to phase 6. Else none. Why:
-/// the rounds are sequential, so one check-level case of hours kept every other worker idle until it ended
-/// while other cells' check cases were known and waiting (the certified Table 1, 2026-12-05).
-std::vector<CaseParams> check_level_cases_while_running(const std::vector<SampleGroup>& groups,
-                                                        const MultiFidelityOptions& o,
-                                                        const std::vector<int>& running_levels, int budget);
+/// @brief Whether the rounds may go on while cases still run (the scheduler's top-up of a worker left without a
+/// queued case): only with a check level, and only while every running case is a check-level one
+/// (@p running_levels: the mesh levels of the running cases). Why: the rounds are sequential, so one
+/// check-level case of hours kept every other worker idle until it ended, while the answer level and other
+/// cells had work waiting (the certified Table 1, 2026-12-05: four level-3 refinements and the check level of
+/// other cells behind one level-4 case). A running answer-level case may still move a bracket, so then
+/// nothing; a running check-level case changes at most its own cell's mesh error, i.e. whether a level-3
+/// bisection there is still needed (a few minutes of a core, not hours).
+bool rounds_may_overlap(const MultiFidelityOptions& o, const std::vector<int>& running_levels);
 
 /// @brief Phase 5: per cell, the CaH-low case of the answer level (else its Ca*-low case) with time.dt set
 /// to half the step it ran with; none in a cell that has a dt check case already (any Ca, any status).

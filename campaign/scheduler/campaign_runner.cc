@@ -343,15 +343,8 @@ int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& 
     const auto& lv = spec.analysis.levels;
     const MultiFidelityOptions mf{lv, spec.analysis.d12_threshold, spec.analysis.ca_tolerance, spec.analysis.adaptive,
                                   spec.analysis.dt_check, spec.analysis.check_precision};
-    if (running_levels) {  // a top-up while cases run: the check level only, once nothing running can change it
-      if (what) *what = "multi-fidelity: mesh check on level " + std::to_string(lv.back());
-      add = check_level_cases_while_running(groups, mf, *running_levels, budget);
-      if (add.empty()) return 0;
-      Transaction t(store.db());
-      const int added = store.add_cases(campaign_id, add, "adaptive", runs_dir);
-      t.commit();
-      return added;
-    }
+    // A top-up while cases run (Runner::set_top_up): the same phases, once only check-level cases run.
+    if (running_levels && !rounds_may_overlap(mf, *running_levels)) return 0;
     add = answer_level_round(groups, mf, budget);
     phase = "multi-fidelity: level " + std::to_string(lv[1]) + " (seed, re-bracket" +
             (spec.analysis.adaptive ? ", refine)" : ")");
@@ -549,8 +542,8 @@ int run_campaign(const RunOptions& opt, const BeforeRun& before_run) {
   runner.message("capsim campaign: '" + spec.name + "': " + std::to_string(cases.size()) + " grid cases, " +
                  std::to_string(jobs) + " job(s) x " + std::to_string(threads) + " thread(s), database " + opt.db_path);
 
-  // With a check level, a worker left without a queued case while another runs (a level-4 case takes hours)
-  // takes the check level's cases that nothing running can change, instead of waiting for the round to end.
+  // With a check level, a worker left without a queued case while only check-level cases run (they take hours
+  // on level 4) takes the next round's cases instead of waiting for the round to end (rounds_may_overlap).
   if (spec.analysis.levels.size() > 2)
     runner.set_top_up([&](const std::vector<int>& running_levels) {
       std::string what;

@@ -97,9 +97,9 @@ bool reanalyse_campaign(Store& store, std::int64_t campaign_id);
 /// cases it added to the campaign (0: nothing left to refine).
 /// With [analysis] levels, the next phase of analysis/multi_fidelity.h that adds cases (answer-level rounds,
 /// then the check level, then the dt check); @p what, if given, names the phase.
-/// With @p running_levels (the mesh levels of the cases still running), only the check level's cases that
-/// nothing running can change (analysis/multi_fidelity.h, check_level_cases_while_running): the top-up of a
-/// worker that would otherwise wait for the round's last case.
+/// With @p running_levels (the mesh levels of the cases still running): the same, but only when every running
+/// case is a check-level one (analysis/multi_fidelity.h, rounds_may_overlap), else 0 — the top-up of a worker
+/// that would otherwise wait for the round's last case.
 int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir,
                     std::string* what = nullptr, const std::vector<int>* running_levels = nullptr);
 

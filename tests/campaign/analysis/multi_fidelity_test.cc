@@ -267,43 +267,17 @@ TEST(MultiFidelity, TheCheckLevelInMixedPrecisionJoinsTheDoubleGroup) {
   }
 }
 
-// The scheduler's top-up: while cases run, the check level's cases are proposed only when every running case
-// is a check-level one and the phases before it add nothing — the state in which the rounds would move on.
-TEST(MultiFidelity, TheCheckLevelTopsUpAFreeWorkerOnlyWhenNothingRunningCanChangeIt) {
-  std::vector<CaseSample> cases;
-  for (double ca : {0.1, 0.2, 0.5, 1.0}) cases.push_back(fake(2, ca, tau2));
-  for (double ca : {0.1, 0.2, 0.5, 0.55, 0.65, 1.0}) cases.push_back(fake(3, ca, tau3));  // scan brackets seeded
+// The scheduler's top-up: the rounds go on while cases run only with a check level and only while every
+// running case is a check-level one.
+TEST(MultiFidelity, RoundsOverlapOnlyWhileCheckLevelCasesRun) {
   MultiFidelityOptions o = kOptions;
+  EXPECT_FALSE(rounds_may_overlap(o, {3})) << "no check level";
   o.levels = {2, 3, 4};
-  o.adaptive = false;  // the answer level is final: no bisection left
-  {
-    const auto more = answer_level_round(group_cases(cases), o, 100);
-    std::string listed;
-    for (const auto& p : more) listed += " " + std::to_string(p.capillary_number()) + "@L" + std::to_string(p.mesh_level());
-    ASSERT_TRUE(more.empty()) << "the test needs a final answer level; it proposes" << listed;
-  }
-  // A level-4 case of this cell running (another bracket's, at 0.1): the final bracket's cases are proposed.
-  cases.push_back(fake(4, 0.1, tau3, "running"));
-  EXPECT_EQ(ca_at(check_level_cases_while_running(group_cases(cases), o, {4}, 100), 4), (std::vector<double>{0.55, 0.65}));
-  EXPECT_TRUE(check_level_cases_while_running(group_cases(cases), o, {4}, 0).empty()) << "no budget";
-  // An answer-level case still running may move the bracket: nothing yet.
-  EXPECT_TRUE(check_level_cases_while_running(group_cases(cases), o, {4, 3}, 100).empty());
-  // No check level: nothing.
-  MultiFidelityOptions two = o;
-  two.levels = {2, 3};
-  EXPECT_TRUE(check_level_cases_while_running(group_cases(cases), two, {3}, 100).empty());
-  // An answer-level round still has something to add (a re-bracket: level 3 does not bracket CaH yet): wait.
-  std::vector<CaseSample> open;
-  for (double ca : {0.1, 0.2, 0.5, 1.0}) open.push_back(fake(2, ca, tau2));
-  for (double ca : {0.1, 0.2}) open.push_back(fake(3, ca, tau3));
-  open.push_back(fake(4, 0.1, tau3, "running"));
-  ASSERT_FALSE(answer_level_round(group_cases(open), o, 100).empty());
-  EXPECT_TRUE(check_level_cases_while_running(group_cases(open), o, {4}, 100).empty());
-  // With dt_check, a cell whose dt check is still to be proposed: wait.
-  MultiFidelityOptions with_dt = o;
-  with_dt.dt_check = true;
-  ASSERT_FALSE(dt_check_cases(group_cases(cases), with_dt, 100).empty());
-  EXPECT_TRUE(check_level_cases_while_running(group_cases(cases), with_dt, {4}, 100).empty());
+  EXPECT_TRUE(rounds_may_overlap(o, {4}));
+  EXPECT_TRUE(rounds_may_overlap(o, {4, 4}));
+  EXPECT_TRUE(rounds_may_overlap(o, {})) << "nothing running: the ordinary round";
+  EXPECT_FALSE(rounds_may_overlap(o, {4, 3})) << "an answer-level case may still move a bracket";
+  EXPECT_FALSE(rounds_may_overlap(o, {2}));
 }
 
 // Where the check level's values at the final bracket lie on one side of 0 (its CaH is outside the bracket),

@@ -149,8 +149,8 @@ max_rounds = 20
 }
 
 // Rounds are sequential, so a worker left without a queued case used to wait for the round's last case — on
-// the certified Table 1 a level-4 case of hours. With a check level the free worker now takes the check
-// level's cases that nothing running can change (analysis/multi_fidelity.h, check_level_cases_while_running).
+// the certified Table 1 a level-4 case of hours. Once only check-level cases run, the free worker now takes the
+// next round's cases (analysis/multi_fidelity.h, rounds_may_overlap).
 // Fake CaH of level L = 0.70 − 0.08 · 2^-L: level 3's CaH lies above level 2's final bracket, so the check
 // level's second round runs the answer level's next sample outwards (0.8). With the Ca* check case at 0.015
 // slow, that case starts while 0.015 still runs; the cases and the answers are those of the plain run.

@@ -13,22 +13,21 @@
 namespace capsim::campaign::testing {
 namespace {
 
-TEST(MultiFidelity, ScanAnswerCheckAndTheErrorBarOfCaH) {
-  const std::string dir = fresh_dir("multi_fidelity");
-  const std::string db = dir + "/study.db";
-  write_file(dir + "/mf.toml", R"([campaign]
-name = "mf"
-[[grid]]
+// The oblate NH grid of these tests, adaptive, to which each test adds its [analysis] levels (and dt_check).
+const std::string kOblateGrid = R"([[grid]]
 aspect_ratio = [0.5]
 law = ["neo-hookean"]
 capillary_number = [0.01, 0.02, 0.03, 0.04, 0.05, 0.1, 0.4, 0.8, 1.2]
 [analysis]
-levels = [1, 2, 3]
-dt_check = true
 adaptive = true
 ca_tolerance = 0.005
 max_rounds = 20
-)");
+)";
+
+TEST(MultiFidelity, ScanAnswerCheckAndTheErrorBarOfCaH) {
+  const std::string dir = fresh_dir("multi_fidelity");
+  const std::string db = dir + "/study.db";
+  write_file(dir + "/mf.toml", "[campaign]\nname = \"mf\"\n" + kOblateGrid + "levels = [1, 2, 3]\ndt_check = true\n");
   // CaH of level L = 0.70 − 0.8 · 2^-L − 10 dt²: 0.30 / 0.50 / 0.60 on levels 1 / 2 / 3 (dt 0.01), limit 0.699.
   const std::string env = "FAKE_STEPS=1 FAKE_STEP_S=0.001 FAKE_LEVEL_SHIFT=0.8 FAKE_DT_COEF=10";
   auto r = sh(campaign_cmd(env, dir + "/mf.toml", db, "--jobs 2"));
@@ -102,15 +101,7 @@ max_rounds = 20
 // half an error off. With the answer shifted by more than its error the check must say so.
 TEST(MultiFidelity, ErrorCheckPlacesTheFinerLevelAgainstTheTwoLevelErrorBar) {
   const std::string dir = fresh_dir("multi_fidelity_error_check");
-  const std::string grid = R"([[grid]]
-aspect_ratio = [0.5]
-law = ["neo-hookean"]
-capillary_number = [0.01, 0.02, 0.03, 0.04, 0.05, 0.1, 0.4, 0.8, 1.2]
-[analysis]
-adaptive = true
-ca_tolerance = 0.005
-max_rounds = 20
-)";
+  const std::string& grid = kOblateGrid;
   write_file(dir + "/two.toml", "[campaign]\nname = \"two\"\n" + grid + "levels = [1, 2]\n");
   write_file(dir + "/three.toml", "[campaign]\nname = \"three\"\n" + grid + "levels = [1, 2, 3]\n");
   const std::string env = "FAKE_STEPS=1 FAKE_STEP_S=0.001 FAKE_LEVEL_SHIFT=0.8";
@@ -156,18 +147,7 @@ max_rounds = 20
 // slow, that case starts while 0.015 still runs; the cases and the answers are those of the plain run.
 TEST(MultiFidelity, AFreeWorkerTakesTheCheckLevelsNextCaseWhileALongOneRuns) {
   const std::string dir = fresh_dir("multi_fidelity_top_up");
-  write_file(dir + "/mf.toml", R"([campaign]
-name = "mf"
-[[grid]]
-aspect_ratio = [0.5]
-law = ["neo-hookean"]
-capillary_number = [0.01, 0.02, 0.03, 0.04, 0.05, 0.1, 0.4, 0.8, 1.2]
-[analysis]
-levels = [1, 2, 3]
-adaptive = true
-ca_tolerance = 0.005
-max_rounds = 20
-)");
+  write_file(dir + "/mf.toml", "[campaign]\nname = \"mf\"\n" + kOblateGrid + "levels = [1, 2, 3]\n");
   const std::string env = "FAKE_STEPS=1 FAKE_STEP_S=0.001 FAKE_LEVEL_SHIFT=0.08";
   auto level3 = [&](const std::string& db) {
     return sh(exe() + " query sql \"SELECT capillary_number AS ca, started_at, finished_at FROM cases WHERE mesh_level = 3 "

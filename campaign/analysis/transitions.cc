@@ -140,7 +140,7 @@ std::string group_difference(const std::string& a, const std::string& b) {
 
 std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases) {
   std::map<std::string, std::size_t> index;
-  std::map<std::size_t, std::vector<double>> double_ca;  // per group: the Ca whose sample is a double case
+  std::vector<std::vector<bool>> sample_is_double;  // per group, aligned with its samples
   std::vector<SampleGroup> out;
   for (const auto& c : cases) {
     const std::string key = group_key(c.params);
@@ -154,6 +154,7 @@ std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases) {
       g.key.mesh_level = c.params.mesh_level();
       g.base = c.params;
       out.push_back(std::move(g));
+      sample_is_double.emplace_back();
     }
     SampleGroup& g = out[it->second];
     const double ca = c.params.capillary_number();
@@ -165,14 +166,14 @@ std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases) {
     const auto precision = values.find("numerics.kernel_precision");
     const std::string* text = precision == values.end() ? nullptr : std::get_if<std::string>(&precision->second);
     const bool is_double = !text || *text == "double";
+    auto& doubles = sample_is_double[it->second];
     const auto same = std::find_if(g.samples.begin(), g.samples.end(), [&](const Sample& s) { return same_ca(s.ca, ca); });
     if (same == g.samples.end()) {
       g.samples.push_back(sample);
-      if (is_double) double_ca[it->second].push_back(ca);
-    } else if (is_double && std::none_of(double_ca[it->second].begin(), double_ca[it->second].end(),
-                                         [&](double x) { return same_ca(x, ca); })) {
+      doubles.push_back(is_double);
+    } else if (const auto k = static_cast<std::size_t>(same - g.samples.begin()); is_double && !doubles[k]) {
       *same = sample;
-      double_ca[it->second].push_back(ca);
+      doubles[k] = true;
     }
   }
   return out;

@@ -97,9 +97,7 @@ class Runner {
   bool run_queued() {
     learn_costs();
     auto rows = store_.campaign_cases(campaign_id_);
-    std::vector<CaseRow> pending;
-    for (auto& r : rows)
-      if (r.status == "queued" && !interrupted_.count(r.case_id)) pending.push_back(r);
+    std::vector<CaseRow> pending = startable(rows);
     order(pending);
     total_ = static_cast<int>(rows.size());
     finished_ = failed_ = 0;
@@ -132,11 +130,7 @@ class Runner {
         for (const auto& [_, r] : running_) levels.push_back(r.row.params.mesh_level());
         if (top_up_(levels) > 0) {
           rows = store_.campaign_cases(campaign_id_);
-          std::set<std::string> running_ids;
-          for (const auto& [_, r] : running_) running_ids.insert(r.row.case_id);
-          for (auto& r : rows)
-            if (r.status == "queued" && !interrupted_.count(r.case_id) && !running_ids.count(r.case_id))
-              pending.push_back(r);
+          pending = startable(rows);  // pending was empty: the new cases
           order(pending);
           total_ = static_cast<int>(rows.size());
         }
@@ -162,6 +156,16 @@ class Runner {
   int interrupted() const { return static_cast<int>(interrupted_.size()); }
 
  private:
+  // The queued cases this run may start: not interrupted by it, not running.
+  std::vector<CaseRow> startable(const std::vector<CaseRow>& rows) const {
+    std::set<std::string> running_ids;
+    for (const auto& [_, r] : running_) running_ids.insert(r.row.case_id);
+    std::vector<CaseRow> out;
+    for (const auto& r : rows)
+      if (r.status == "queued" && !interrupted_.count(r.case_id) && !running_ids.count(r.case_id)) out.push_back(r);
+    return out;
+  }
+
   // The queue in the order of --order, the next case last (pop_back).
   void order(std::vector<CaseRow>& pending) {
     // longest first keeps the workers busy to the end of a campaign that finishes (the long cases do not

@@ -96,7 +96,7 @@ bool reanalyse_campaign(Store& store, std::int64_t campaign_id);
 /// @brief One adaptive round (analysis/refinement.h) within the campaign's max_cases budget; returns how many
 /// cases it added to the campaign (0: nothing left to refine).
 /// With [analysis] levels, the next phase of analysis/multi_fidelity.h that adds cases (answer-level rounds,
-/// then the check level, then the dt check); @p what, if given, names the phase.
+/// then the dt check, then the check level); @p what, if given, names the phase.
 /// With @p running_levels (the mesh levels of the cases still running): the same, but only when every running
 /// case is a check-level one (analysis/multi_fidelity.h, rounds_may_overlap), else 0 — the top-up of a worker
 /// that would otherwise wait for the round's last case.

@@ -1,13 +1,17 @@
 #include "campaign/grid/case_params.h"
 
 #include <cmath>
+#include <map>
+#include <mutex>
+#include <tuple>
 #include <nlohmann/json.hpp>
 
 #include "campaign/common/bad_input.h"
 #include "campaign/grid/sha256.h"
 #include "capsim/version.h"
 #include "solver/config/case_config.h"
-#include "solver/dynamics/time_stepper.h"
+#include "solver/dynamics/capsule_flow.h"
+#include "solver/mesh/mesh.h"
 #include "solver/solver_version.h"
 
 namespace capsim::campaign {
@@ -105,12 +109,27 @@ std::string CaseParams::to_toml() const {
   return out;
 }
 
+namespace {
+/// The smallest node spacing of a case's reference mesh: what its stage count starts from. Built once per
+/// (level, a/b, map); a level-4 mesh takes milliseconds.
+double reference_min_spacing(const config::CaseConfig& c) {
+  static std::mutex mutex;
+  static std::map<std::tuple<int, double, std::string>, double> cache;
+  const std::lock_guard<std::mutex> lock(mutex);
+  const auto key = std::make_tuple(c.level, c.aspect_ratio, c.spheroid_map);
+  auto it = cache.find(key);
+  if (it == cache.end()) {
+    const auto m = mesh::make_capsule_mesh(c.level, c.aspect_ratio, mesh::parse_spheroid_map(c.spheroid_map));
+    it = cache.emplace(key, mesh::min_node_spacing(m, m.nodes)).first;
+  }
+  return it->second;
+}
+}  // namespace
+
 double CaseParams::estimated_cost() const {
-  // Bending stiffness multiplies the RKC stages by sqrt(1 + ρ_b/ρ_el), ρ_b/ρ_el = C_b κ_b/(C_el h²) with the
-  // node spacing h ≈ 0.55 · 2^−level of the sphere mesh (dynamics::membrane_spectral_radius).
-  const double h = 0.55 * std::pow(2.0, -mesh_level());
-  const double bending = std::sqrt(1.0 + dynamics::bending_stiffness_ratio(bending_modulus(), h));
-  return bending * t_end() * std::pow(2.0, 5.0 * mesh_level()) / std::max(capillary_number(), 1e-6);
+  const config::CaseConfig c = config::parse_case_config(to_toml(), "case " + to_json());
+  return c.t_end * dynamics::evaluations_per_unit_time(c, reference_min_spacing(c)) *
+         std::pow(kEvaluationCostPerLevel, c.level);
 }
 
 }  // namespace capsim::campaign

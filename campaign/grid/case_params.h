@@ -54,9 +54,18 @@ class CaseParams {
   std::string to_json() const;
   /// @brief A case file for `capsim run` (TOML sections).
   std::string to_toml() const;
-  /// @brief Relative cost estimate, for longest-first ordering: t_end * (2^level)^5 / Ca, times the growth
-  /// of the RKC stages with bending stiffness (see the definition).
+  /// @brief Relative cost estimate, for the order cases start in and the ETA's per-level fit:
+  ///   t_end · (flow evaluations per unit time) · kEvaluationCostPerLevel^level,
+  /// the evaluations per unit time from the solver's own step rule on the reference mesh
+  /// (dynamics::evaluations_per_unit_time: the RKC stages grow as (Ca h)^−1/2, with bending as
+  /// sqrt(1 + ρ_b/ρ_el)). Not a prediction of seconds: prestress adds stages along a run and periodic cases
+  /// stop before t_end (the EtaModel fits wall ∝ est^β per level). Does not see numerics.kernel_precision.
+  /// @throws capsim::config::ConfigError if the solver rejects the case.
   double estimated_cost() const;
+  /// @brief What one flow evaluation costs per mesh level finer (×4 nodes): the all-pairs sum alone would be
+  /// 16, the near and singular parts 4; `capsim bench flow` measured 8.2 (mixed) and 10.3 (double) from level 3
+  /// to 4 (results/speed/bench_flow_L{3,4}_T1*.json).
+  static constexpr double kEvaluationCostPerLevel = 9.0;
 
  private:
   std::map<std::string, Value> values_;

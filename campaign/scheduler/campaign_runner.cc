@@ -180,10 +180,15 @@ class Runner {
         left[r.case_id] = (whole >= 0 ? whole : r.est_cost) *
                           (r.resumable ? work_fraction_left(r.out_dir, r.params.t_end()) : 1.0);
       }
+      // Equal estimates are common (the stage count at rest is an integer): the smaller Ca counts as longer,
+      // since its stiffness is the larger and the prestress of the run adds its next stage sooner.
+      const auto longer = [&](const CaseRow& a, const CaseRow& b) {
+        if (left[a.case_id] != left[b.case_id]) return left[a.case_id] > left[b.case_id];
+        return a.params.capillary_number() < b.params.capillary_number();
+      };
       const bool longest = opt_.order == "longest";
-      std::stable_sort(pending.begin(), pending.end(), [&](const CaseRow& a, const CaseRow& b) {
-        return longest ? left[a.case_id] > left[b.case_id] : left[a.case_id] < left[b.case_id];
-      });
+      std::stable_sort(pending.begin(), pending.end(),
+                       [&](const CaseRow& a, const CaseRow& b) { return longest ? longer(a, b) : longer(b, a); });
     }
     std::reverse(pending.begin(), pending.end());  // pop_back = next case
   }
@@ -496,6 +501,7 @@ PreparedCampaign prepare_campaign(const RunOptions& opt, const std::function<voi
     Transaction t(pc.store->db());
     pc.campaign_id = pc.store->upsert_campaign(pc.spec);
     pc.store->add_cases(pc.campaign_id, pc.cases, "grid", pc.runs_dir);
+    pc.store->refresh_cost_estimates(pc.campaign_id);
     // The campaign is its file's grid plus what its analysis added: links an earlier version of the file made
     // (a value since removed from an axis) go, or the run would start cases the dry run does not list and the
     // analysis would read samples the file no longer asks for. The cases themselves stay in the database.

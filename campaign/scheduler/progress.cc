@@ -57,7 +57,7 @@ double EtaModel::expected_s(int mesh_level, double est_cost) const {
   for (const auto& [level, _] : by_level_)
     if (std::abs(level - mesh_level) < std::abs(nearest - mesh_level)) nearest = level;
   const int d = mesh_level - nearest;
-  return std::exp(predict_log(by_level_.at(nearest), x - d * std::log(32.0))) * std::pow(kMeasuredPerLevel, d);
+  return std::exp(predict_log(by_level_.at(nearest), x - d * std::log(kEstimatePerLevel))) * std::pow(kMeasuredPerLevel, d);
 }
 
 double EtaModel::remaining_s(const std::vector<Work>& cases, int jobs) const {

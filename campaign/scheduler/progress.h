@@ -46,9 +46,10 @@ class Progress {
 
 /// @brief The time a campaign still needs, from what its finished cases cost.
 ///
-/// CaseParams::estimated_cost is a rough power law: 32× per mesh level, ∝ t_end / Ca. Whole cases measure
-/// neither: ≈ 9× per level, and within one level wall ∝ est_cost^0.2–0.33, not ∝ est_cost (the stage count
-/// grows like Ca^-1/2 only where the step is stability-limited, and periodic cases stop early). One ratio of
+/// CaseParams::estimated_cost is t_end × the evaluations per unit time of the solver's step rule on the
+/// reference mesh × 9^level. Whole cases follow it only loosely: within one level wall ∝ est_cost^0.55–0.83
+/// (periodic cases stop before t_end, prestress adds stages along a run), and the same case costs ≈ 9× per
+/// level finer where its estimate grows ≈ 12×. One ratio of
 /// wall time to estimated cost, taken over the cheap cases that ran first (`--order shortest`, or a level-2
 /// scan before level 3), misjudged the expensive rest by an order of magnitude (a certified Table 1 read
 /// ETA 134 h for about 25 h of work). So each mesh level fits its own power law
@@ -60,7 +61,7 @@ class Progress {
 /// one estimate, give β = kCostExponent; a hundred spread cases give their own β. The prediction is the
 /// arithmetic mean (× exp(s²/2), s² the residual variance in log wall), since the ETA sums predictions. A
 /// level with no finished case yet uses the nearest level that has one (the coarser on a tie): its law at
-/// the estimate moved to that level (÷ 32 per level), times kMeasuredPerLevel per level.
+/// the estimate moved to that level (÷ kEstimatePerLevel per level), times kMeasuredPerLevel per level.
 class EtaModel {
  public:
   /// @brief What a whole case costs per mesh level finer, as measured: the geometric mean of the wall-time
@@ -68,10 +69,17 @@ class EtaModel {
   /// level-2/3 pairs, 9.5 over 5 level-3/4 pairs; single pairs range 1.1-24). Only an ETA's first guess for
   /// a level that has no finished case yet.
   static constexpr double kMeasuredPerLevel = 9.0;
-  /// @brief The exponent β of wall ∝ est_cost^β within one level, as measured (2026-12-03, least squares in
-  /// log-log): 0.28 over the 106 level-3 cases of table1.sqlite, 0.33 / 0.30 over 46 level-2 / 58 level-3
-  /// cases of table1_certified.sqlite, 0.19 / 0.24 over 112 / 101 of bending/table1_bending.sqlite.
-  static constexpr double kCostExponent = 0.3;
+  /// @brief What the estimate of the same case grows per mesh level finer: the geometric mean over the 44
+  /// level-2/3 and 3/4 pairs of table1_certified.sqlite (2026-12-05: 11.9, pairs 9–15; 17.9 over the 57 pairs
+  /// of bending/table1_bending.sqlite, where the bending stiffness grows as h^−2).
+  static constexpr double kEstimatePerLevel = 12.0;
+  /// @brief The exponent β of wall ∝ est_cost^β within one level, as measured (2026-12-05, least squares in
+  /// log-log; EtaModel.TheCostExponentIsTheFitOfTheCommittedDatabases redoes it): 0.74 over the 106 level-3
+  /// cases of table1.sqlite; 0.82 / 0.81 over 46 level-2 / 66 level-3 cases of table1_certified.sqlite;
+  /// 0.73 / 0.82 over 46 / 57 of table1_mf_mixed.sqlite; 0.55 / 0.75 over 112 / 161 of
+  /// bending/table1_bending.sqlite. (With the estimate ∝ 1/Ca before 2026-12-05 it was 0.19–0.33, and the
+  /// residual spread in log wall was up to 20% larger.)
+  static constexpr double kCostExponent = 0.75;
   /// @brief How strongly β is drawn to kCostExponent: the Σ (log est − mean)² of a prior of that weight.
   static constexpr double kPriorWeight = 4.0;
   /// @brief Records a finished case: its level, estimated cost and measured wall seconds (of the whole

@@ -313,6 +313,27 @@ int Store::add_cases(std::int64_t campaign_id, const std::vector<CaseParams>& ca
   return linked;
 }
 
+int Store::refresh_cost_estimates(std::int64_t campaign_id) {
+  std::vector<std::pair<std::string, double>> changed;
+  {
+    Stmt s(*db_,
+           "SELECT c.case_id, c.params_json, c.est_cost FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id "
+           "WHERE cc.campaign_id=?");
+    s.bind(1, campaign_id);
+    while (s.step()) {
+      const double est = CaseParams::from_json(s.text(1)).estimated_cost();
+      if (est != s.real(2).value_or(0.0)) changed.emplace_back(s.text(0), est);
+    }
+  }
+  Stmt upd(*db_, "UPDATE cases SET est_cost=? WHERE case_id=?");
+  for (const auto& [id, est] : changed) {
+    upd.reset();
+    upd.bind(1, est).bind(2, id);
+    upd.step();
+  }
+  return static_cast<int>(changed.size());
+}
+
 namespace {
 const char* kCaseCols =
     "c.case_id,c.params_json,c.status,c.resumable,c.attempts,c.est_cost,c.out_dir,coalesce(c.host,''),"

@@ -115,6 +115,10 @@ class Store {
   std::optional<std::string> latest_campaign();
   /// @brief Adds cases (new rows queued) and links them to the campaign; returns how many were new to the
   /// campaign (a case another campaign already holds is linked, and counts; one it holds already does not).
+  /// @brief Recomputes est_cost (CaseParams::estimated_cost) of the campaign's cases whose stored value
+  /// differs, so that a database written before the estimator changed starts its queue in today's order and
+  /// the ETA fits finished and queued cases on one scale (EtaModel). Returns how many changed.
+  int refresh_cost_estimates(std::int64_t campaign_id);
   int add_cases(std::int64_t campaign_id, const std::vector<CaseParams>& cases, const std::string& origin,
                 const std::string& runs_dir);
   /// @brief Cases of a campaign.

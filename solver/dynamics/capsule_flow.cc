@@ -122,25 +122,42 @@ FlowEvaluation CapsuleFlow::velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd
   return out;
 }
 
+namespace {
+double stable_time_step(double h_min, double capillary_number, double factor) {
+  return factor * capillary_number * h_min / (1.0 + kLargeCaCoefficient * capillary_number);
+}
+}  // namespace
+
 double automatic_time_step(const mesh::SurfaceMesh& mesh, double capillary_number, double factor) {
-  return factor * capillary_number * mesh::min_node_spacing(mesh, mesh.nodes) /
-         (1.0 + kLargeCaCoefficient * capillary_number);
+  return stable_time_step(mesh::min_node_spacing(mesh, mesh.nodes), capillary_number, factor);
 }
 
 double automatic_time_step(const config::CaseConfig& config, const mesh::SurfaceMesh& mesh) {
-  double stable = automatic_time_step(mesh, config.capillary_number, config.dt_factor);
+  return automatic_time_step(config, mesh::min_node_spacing(mesh, mesh.nodes));
+}
+
+double automatic_time_step(const config::CaseConfig& config, double h_min) {
+  double stable = stable_time_step(h_min, config.capillary_number, config.dt_factor);
   if (config.bending_modulus <= 0.0) return config.scheme == "rkc" ? std::max(config.dt_accuracy, stable) : stable;
-  const double h = mesh::min_node_spacing(mesh, mesh.nodes);
-  stable /= 1.0 + bending_stiffness_ratio(config.bending_modulus, h);
+  stable /= 1.0 + bending_stiffness_ratio(config.bending_modulus, h_min);
   if (config.scheme != "rkc") return stable;
   // A stiff bending membrane on a fine mesh can need more stages than RKC allows at the accuracy step
   // (level 4, κ_b = 0.1: ≈ 600): cap dt so the reference state needs at most half of them, leaving room for
   // the prestress and the shrinking h_min of the deformed states.
   const RkcIntegrator::Options rkc;
-  const double rho = config.rkc_safety * membrane_spectral_radius(mesh, mesh.nodes, config.capillary_number, 0.0,
-                                                                   config.bending_modulus);
+  const double rho =
+      config.rkc_safety * membrane_spectral_radius(h_min, config.capillary_number, 0.0, config.bending_modulus);
   const double cap = RkcIntegrator::stability_boundary(rkc.max_stages / 2, rkc.damping) / rho;
   return std::min(std::max(config.dt_accuracy, stable), cap);
+}
+
+double evaluations_per_unit_time(const config::CaseConfig& config, double h_min) {
+  const double dt = config.dt ? *config.dt : automatic_time_step(config, h_min);
+  if (config.scheme != "rkc") return 2.0 / dt;
+  const RkcIntegrator::Options rkc;
+  const double rho =
+      config.rkc_safety * membrane_spectral_radius(h_min, config.capillary_number, 0.0, config.bending_modulus);
+  return RkcIntegrator::stages_for(dt * rho, rkc.damping) / dt;
 }
 
 }  // namespace capsim::dynamics

@@ -137,5 +137,16 @@ inline constexpr double kLargeCaCoefficient = 0.75;
 /// RkcIntegrator::Options::max_stages on the reference state (dt is capped below the accuracy step where
 /// that would be exceeded).
 double automatic_time_step(const config::CaseConfig& config, const mesh::SurfaceMesh& mesh);
+/// @brief The same for a mesh whose smallest node spacing is @p h_min (the mesh form evaluates it there).
+double automatic_time_step(const config::CaseConfig& config, double h_min);
+
+/// @brief Flow evaluations per unit time the configured time stepping takes on the reference shape with
+/// smallest node spacing @p h_min: 2/dt for rk2, stages/dt for rkc with the stages RkcIntegrator chooses for
+/// membrane_spectral_radius at rest (safety included); dt is time.dt when set, else the automatic dt.
+/// Along a run the prestress and the shrinking h_min add stages, and periodic cases stop before t_end, so it
+/// is a rate, not a prediction: the campaign's relative cost estimate (CaseParams::estimated_cost) is built
+/// on it because the stages — hence the cost per unit time — grow as (Ca h)^−1/2 where the step is
+/// accuracy-limited, not as 1/(Ca h).
+double evaluations_per_unit_time(const config::CaseConfig& config, double h_min);
 
 }  // namespace capsim::dynamics

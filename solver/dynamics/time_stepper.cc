@@ -134,9 +134,7 @@ std::unique_ptr<TimeIntegrator> make_integrator(const std::string& scheme, doubl
 
 double membrane_spectral_radius(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x, double capillary_number,
                                 double tau_max, double bending_modulus) {
-  const double h = mesh::min_node_spacing(mesh, x);
-  return kSpectralRadiusConstant * (1.0 + kPrestressCoefficient * std::max(tau_max, 0.0)) / (capillary_number * h) +
-         kBendingSpectralConstant * bending_modulus / (capillary_number * h * h * h);
+  return membrane_spectral_radius(mesh::min_node_spacing(mesh, x), capillary_number, tau_max, bending_modulus);
 }
 
 double estimate_spectral_radius(CapsuleFlow& flow, const Eigen::Matrix3Xd& x, int iterations) {

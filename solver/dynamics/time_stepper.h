@@ -157,6 +157,15 @@ inline constexpr double kSpectralRadiusConstant = 6.5;
 inline constexpr double kPrestressCoefficient = 0.4;
 inline constexpr double kBendingSpectralConstant = 45.0;
 
+/// @brief The estimate above for a smallest node spacing @p h_min: the one formula, which the mesh form
+/// evaluates at h_min(x) and the campaign's cost estimate at the reference mesh's h_min.
+inline double membrane_spectral_radius(double h_min, double capillary_number, double tau_max,
+                                       double bending_modulus = 0.0) {
+  return kSpectralRadiusConstant * (1.0 + kPrestressCoefficient * (tau_max > 0.0 ? tau_max : 0.0)) /
+             (capillary_number * h_min) +
+         kBendingSpectralConstant * bending_modulus / (capillary_number * h_min * h_min * h_min);
+}
+
 /// @brief ρ_bending / ρ_elastic of the estimate above at node spacing h without prestress:
 /// kBendingSpectralConstant κ_b / (kSpectralRadiusConstant h²). The one place the automatic dt and the
 /// campaign's cost estimate take the bending stiffness from.

@@ -46,7 +46,7 @@ TEST(CampaignRunner, ShortestFirstStartsTheLargestCaFirst) {
 TEST(CampaignRunner, AResumedCaseIsOrderedByTheWorkItHasLeft) {
   const std::string dir = fresh_dir("runner_order_resumed");
   const std::string db = dir + "/study.db";
-  // t_end = 0.11: a checkpoint at γ̇t = 0.1 leaves 9 % of the case, less than 0.01's estimate over 0.06's (1/6).
+  // t_end = 0.11: a checkpoint at γ̇t = 0.1 leaves 9 % of the case, less than 0.06's estimate over 0.01's.
   std::string six = kSix;
   six.replace(six.find("mesh.level = 1\n"), 15, "mesh.level = 1\ntime.t_end = 0.11\n");
   write_file(dir + "/c.toml", six);

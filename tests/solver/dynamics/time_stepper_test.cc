@@ -303,5 +303,29 @@ TEST(Rkc, AutomaticStepKeepsTheStagesWithinReachUnderBending) {
   EXPECT_LT(automatic_time_step(c, mesh::make_capsule_mesh(4, c.aspect_ratio)), c.dt_accuracy) << "capped";
 }
 
+// The campaign's cost estimate takes its evaluations per unit time from evaluations_per_unit_time: on the
+// reference shape they are exactly what the first step takes (rkc: the stages for the stiffness at rest;
+// rk2: two per step), at the automatic dt or a set time.dt, with and without bending.
+TEST(Rkc, EvaluationsPerUnitTimeAreWhatTheFirstStepAtRestTakes) {
+  for (const std::string scheme : {"rkc", "rk2"})
+    for (double Ca : {0.02, 0.5, 3.0})
+      for (double kb : {0.0, 1e-3})
+        for (double set_dt : {0.0, 0.004}) {
+          config::CaseConfig c = make_case(1, Ca, 0.5);
+          c.scheme = scheme;
+          c.bending_modulus = kb;
+          if (set_dt > 0) c.dt = set_dt;
+          CapsuleFlow flow(c);
+          const double h = mesh::min_node_spacing(flow.mesh(), flow.reference());
+          const double dt = c.dt ? *c.dt : automatic_time_step(c, flow.mesh());
+          EXPECT_EQ(dt, c.dt ? *c.dt : automatic_time_step(c, h));
+          auto integrator = make_integrator(scheme, c.rkc_safety);
+          Eigen::Matrix3Xd x = flow.reference();
+          const StepInfo info = integrator->step(flow, x, dt);
+          EXPECT_NEAR(evaluations_per_unit_time(c, h) * dt, info.evaluations, 1e-9)
+              << scheme << " Ca " << Ca << " κ_b " << kb << " dt " << dt;
+        }
+}
+
 }  // namespace
 }  // namespace capsim::dynamics

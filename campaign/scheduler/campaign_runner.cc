@@ -552,30 +552,37 @@ int run_campaign(const RunOptions& opt, const BeforeRun& before_run) {
   runner.message("capsim campaign: '" + spec.name + "': " + std::to_string(cases.size()) + " grid cases, " +
                  std::to_string(jobs) + " job(s) x " + std::to_string(threads) + " thread(s), database " + opt.db_path);
 
+  // Multi-fidelity: max_rounds answer-level rounds, then the check level and the dt check (two more). A round
+  // that tops up the queue while check-level cases run counts like any other.
+  const int rounds = spec.analysis.max_rounds + (spec.analysis.levels.empty() ? 0 : 2);
+  int rounds_done = 0;
   // With a check level, a worker left without a queued case while only check-level cases run (they take hours
   // on level 4) takes the next round's cases instead of waiting for the round to end (rounds_may_overlap).
   if (spec.analysis.levels.size() > 2)
     runner.set_top_up([&](const std::vector<int>& running_levels) {
+      if (rounds_done >= rounds) return 0;
       std::string what;
       const int added = refine_campaign(*store, campaign_id, spec, runs_dir, &what, &running_levels);
-      if (added > 0)
-        runner.message("capsim campaign: " + what + ", while " + std::to_string(running_levels.size()) +
-                       " case(s) run: " + std::to_string(added) + " case(s) added");
+      if (added > 0) {
+        ++rounds_done;
+        runner.message("capsim campaign: round " + std::to_string(rounds_done) + ", " + what + ", while " +
+                       std::to_string(running_levels.size()) + " case(s) run: " + std::to_string(added) +
+                       " case(s) added");
+      }
       return added;
     });
   bool completed = runner.run_queued();
   const std::string method = analysis_method(spec.analysis.adaptive, !spec.analysis.levels.empty());
   if (completed && (spec.analysis.adaptive || !spec.analysis.levels.empty())) {
-    // Multi-fidelity: max_rounds answer-level rounds, then the check level and the dt check (two more).
-    const int rounds = spec.analysis.max_rounds + (spec.analysis.levels.empty() ? 0 : 2);
-    for (int round = 1; round <= rounds && completed; ++round) {
+    while (rounds_done < rounds && completed) {
       std::string what;
       int added = refine_campaign(*store, campaign_id, spec, runs_dir, &what);
       if (added == 0) break;
+      ++rounds_done;
       runner.message(spec.analysis.levels.empty()
-                         ? "capsim campaign: adaptive round " + std::to_string(round) + ": " + std::to_string(added) +
-                               " case(s) added"
-                         : "capsim campaign: round " + std::to_string(round) + ", " + what + ": " +
+                         ? "capsim campaign: adaptive round " + std::to_string(rounds_done) + ": " +
+                               std::to_string(added) + " case(s) added"
+                         : "capsim campaign: round " + std::to_string(rounds_done) + ", " + what + ": " +
                                std::to_string(added) + " case(s) added");
       completed = runner.run_queued();
     }

@@ -52,7 +52,7 @@ std::vector<double> ca_at(const std::vector<CaseParams>& cases, int level) {
   return out;
 }
 
-const MultiFidelityOptions kOptions{{2, 3}, 0.05, 0.005, true};
+const MultiFidelityOptions kOptions{{2, 3}, 0.05, 0.005, true, false, ""};
 
 // Level 2: CaH 0.23 (the oblate NH capsule's coarse value); level 3: CaH 0.60.
 double tau2(double ca) { return 0.23 - ca; }
@@ -261,8 +261,11 @@ TEST(MultiFidelity, TheCheckLevelInMixedPrecisionJoinsTheDoubleGroup) {
     for (const auto& g : group_cases(both))
       if (g.key.mesh_level == 4) {
         ASSERT_EQ(g.samples.size(), 2u) << "one sample per Ca";
-        for (const auto& smp : g.samples)
-          if (same_ca(smp.ca, 0.65)) EXPECT_EQ(*smp.max_tau_min, -1.0) << "the double sample, double first " << double_first;
+        for (const auto& smp : g.samples) {
+          if (same_ca(smp.ca, 0.65)) {
+            EXPECT_EQ(*smp.max_tau_min, -1.0) << "the double sample, double first " << double_first;
+          }
+        }
       }
   }
 }
@@ -322,7 +325,7 @@ TEST(MultiFidelity, TheDtCheckHalvesTheStepOfTheCaHLowCase) {
   cases.push_back(fake(3, 0.55, tau3, "done", 0.01));
   EXPECT_TRUE(dt_check_cases(group_cases(cases), kOptions, 100).empty()) << "it exists";
   // The dt_check case does not disturb the answer level's rounds (it is another group).
-  EXPECT_TRUE(answer_level_round(group_cases(cases), MultiFidelityOptions{{2, 3}, 0.05, 0.005, false}, 100).empty());
+  EXPECT_TRUE(answer_level_round(group_cases(cases), MultiFidelityOptions{{2, 3}, 0.05, 0.005, false, false, ""}, 100).empty());
 }
 
 TEST(MultiFidelity, BisectionsSavedCountsWhatRefinementToTheToleranceWouldStillRun) {

@@ -153,8 +153,16 @@ TEST(MultiFidelity, AFreeWorkerTakesTheCheckLevelsNextCaseWhileALongOneRuns) {
     return sh(exe() + " query sql \"SELECT capillary_number AS ca, started_at, finished_at FROM cases WHERE mesh_level = 3 "
                       "ORDER BY capillary_number\" --db " + db + " --format json").out;
   };
+  auto rounds = [](const std::string& err) {
+    int n = 0;
+    for (auto at = err.find("capsim campaign: round "); at != std::string::npos;
+         at = err.find("capsim campaign: round ", at + 1))
+      ++n;
+    return n;
+  };
   auto r = sh(campaign_cmd(env, dir + "/mf.toml", dir + "/plain.db", "--jobs 2"));
   ASSERT_EQ(r.code, 0) << r.err;
+  const int plain_rounds = rounds(r.err);
   const auto plain = nlohmann::json::parse(level3(dir + "/plain.db"));
   std::vector<double> plain_ca;
   for (const auto& c : plain) plain_ca.push_back(c["ca"]);
@@ -165,7 +173,9 @@ TEST(MultiFidelity, AFreeWorkerTakesTheCheckLevelsNextCaseWhileALongOneRuns) {
   r = sh(campaign_cmd(env + " FAKE_SLOW_CA=0.015 FAKE_SLOW_LEVEL=3 FAKE_SLOW_STEP_S=3", dir + "/mf.toml",
                       dir + "/top_up.db", "--jobs 2"));
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.err.find("mesh check on level 3, while 1 case(s) run: 1 case(s) added"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("round 6, multi-fidelity: mesh check on level 3, while 1 case(s) run: 1 case(s) added"),
+            std::string::npos) << r.err;
+  EXPECT_EQ(rounds(r.err), plain_rounds) << "a top-up round counts towards max_rounds like the others: " << r.err;
   const auto top_up = nlohmann::json::parse(level3(dir + "/top_up.db"));
   ASSERT_EQ(top_up.size(), plain.size());
   EXPECT_LT(top_up[6]["started_at"].get<std::string>(), top_up[0]["finished_at"].get<std::string>())

@@ -250,9 +250,10 @@ std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups
   return out;
 }
 
-bool rounds_may_overlap(const MultiFidelityOptions& o, const std::vector<int>& running_levels) {
+bool rounds_may_overlap(const MultiFidelityOptions& o, const std::vector<int>& unfinished_levels) {
   if (o.levels.size() < 3) return false;
-  return std::all_of(running_levels.begin(), running_levels.end(), [&](int level) { return level == o.levels[2]; });
+  return std::all_of(unfinished_levels.begin(), unfinished_levels.end(),
+                     [&](int level) { return level == o.levels[2]; });
 }
 
 std::vector<CaseParams> dt_check_cases(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,

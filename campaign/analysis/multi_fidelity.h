@@ -66,15 +66,17 @@ int bisections_saved(const Transition& t, double ca_tolerance);
 std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,
                                           int budget);
 
-/// @brief Whether the rounds may go on while cases still run (the scheduler's top-up of a worker left without a
-/// queued case): only with a check level, and only while every running case is a check-level one
-/// (@p running_levels: the mesh levels of the running cases). Why: the rounds are sequential, so one
+/// @brief Whether the rounds may go on while cases still run or wait (the scheduler's top-up when a worker is
+/// free): only with a check level, and only while every unfinished case — running or queued — is a
+/// check-level one (@p unfinished_levels: their mesh levels). Why: the rounds are sequential, so one
 /// check-level case of hours kept every other worker idle until it ended, while the answer level and other
 /// cells had work waiting (the certified Table 1, 2026-12-05: four level-3 refinements and the check level of
-/// other cells behind one level-4 case). A running answer-level case may still move a bracket, so then
-/// nothing; a running check-level case changes at most its own cell's mesh error, i.e. whether a level-3
-/// bisection there is still needed (a few minutes of a core, not hours).
-bool rounds_may_overlap(const MultiFidelityOptions& o, const std::vector<int>& running_levels);
+/// other cells behind one level-4 case); and a queue of check-level cases (17 of them, ≈ 36 core-hours) kept
+/// the check case a finished one had just called for (Sk a/b 0.5 at 2.561) behind all of them. An unfinished
+/// answer-level case may still move a bracket, so then nothing; a check-level case changes at most its own
+/// cell's mesh error, i.e. whether a level-3 bisection there is still needed (a few minutes of a core, not
+/// hours), or which check case the cell needs next.
+bool rounds_may_overlap(const MultiFidelityOptions& o, const std::vector<int>& unfinished_levels);
 
 /// @brief Phase 5: per cell, the CaH-low case of the answer level (else its Ca*-low case) with time.dt set
 /// to half the step it ran with; none in a cell that has a dt check case already (any Ca, any status).

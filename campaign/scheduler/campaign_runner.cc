@@ -87,9 +87,11 @@ class Runner {
         runs_dir_(std::move(runs_dir)), worker_(opt.worker.empty() ? default_worker_executable() : opt.worker),
         host_(host_name()) {}
 
-  /// What a free worker may still start when nothing is queued and other cases run: called with the mesh
-  /// levels of the running cases, returns how many cases it added to the campaign (refine_campaign's top-up).
-  using TopUp = std::function<int(const std::vector<int>& running_levels)>;
+  /// The next round's cases, asked for when a worker is free (at the start and each time a case ends) and
+  /// cases are still running or queued: called with the mesh levels of those cases (the running and the
+  /// queued), returns how many cases it added to the campaign (refine_campaign's top-up). New cases join the
+  /// queue in --order.
+  using TopUp = std::function<int(const std::vector<int>& unfinished_levels)>;
   void set_top_up(TopUp top_up) { top_up_ = std::move(top_up); }
 
   /// Runs every queued case of the campaign (and what the top-up adds meanwhile); returns false if stopped
@@ -123,14 +125,15 @@ class Runner {
       const std::size_t before = running_.size();
       reap();
       top_up_due |= running_.size() < before;
-      if (top_up_ && top_up_due && !g_stop_signal && pending.empty() && !running_.empty() &&
+      if (top_up_ && top_up_due && !g_stop_signal && (!pending.empty() || !running_.empty()) &&
           static_cast<int>(running_.size()) < jobs_) {
         top_up_due = false;
         std::vector<int> levels;
         for (const auto& [_, r] : running_) levels.push_back(r.row.params.mesh_level());
+        for (const auto& r : pending) levels.push_back(r.params.mesh_level());
         if (top_up_(levels) > 0) {
           rows = store_.campaign_cases(campaign_id_);
-          pending = startable(rows);  // pending was empty: the new cases
+          pending = startable(rows);  // the queue with the new cases, in --order
           order(pending);
           total_ = static_cast<int>(rows.size());
         }
@@ -342,7 +345,7 @@ bool reanalyse_campaign(Store& store, std::int64_t campaign_id) {
 }
 
 int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir,
-                    std::string* what, const std::vector<int>* running_levels) {
+                    std::string* what, const std::vector<int>* unfinished_levels) {
   const int budget = spec.analysis.max_cases - store.count_campaign_cases(campaign_id, "adaptive");
   const auto groups = group_cases(store.campaign_samples(campaign_id));
   std::vector<CaseParams> add;
@@ -352,8 +355,8 @@ int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& 
     const auto& lv = spec.analysis.levels;
     const MultiFidelityOptions mf{lv, spec.analysis.d12_threshold, spec.analysis.ca_tolerance, spec.analysis.adaptive,
                                   spec.analysis.dt_check, spec.analysis.check_precision};
-    // A top-up while cases run (Runner::set_top_up): the same phases, once only check-level cases run.
-    if (running_levels && !rounds_may_overlap(mf, *running_levels)) return 0;
+    // A top-up while cases run or wait (Runner::set_top_up): the same phases, once only check-level cases are left.
+    if (unfinished_levels && !rounds_may_overlap(mf, *unfinished_levels)) return 0;
     add = answer_level_round(groups, mf, budget);
     phase = "multi-fidelity: level " + std::to_string(lv[1]) + " (seed, re-bracket" +
             (spec.analysis.adaptive ? ", refine)" : ")");
@@ -556,17 +559,18 @@ int run_campaign(const RunOptions& opt, const BeforeRun& before_run) {
   // that tops up the queue while check-level cases run counts like any other.
   const int rounds = spec.analysis.max_rounds + (spec.analysis.levels.empty() ? 0 : 2);
   int rounds_done = 0;
-  // With a check level, a worker left without a queued case while only check-level cases run (they take hours
-  // on level 4) takes the next round's cases instead of waiting for the round to end (rounds_may_overlap).
+  // With a check level, once only check-level cases are left running or queued (they take hours on level 4),
+  // a free worker asks for the next round's cases instead of waiting for the round to end (rounds_may_overlap):
+  // a level-3 refinement or a check case a finished one calls for joins the queue in --order.
   if (spec.analysis.levels.size() > 2)
-    runner.set_top_up([&](const std::vector<int>& running_levels) {
+    runner.set_top_up([&](const std::vector<int>& unfinished_levels) {
       if (rounds_done >= rounds) return 0;
       std::string what;
-      const int added = refine_campaign(*store, campaign_id, spec, runs_dir, &what, &running_levels);
+      const int added = refine_campaign(*store, campaign_id, spec, runs_dir, &what, &unfinished_levels);
       if (added > 0) {
         ++rounds_done;
         runner.message("capsim campaign: round " + std::to_string(rounds_done) + ", " + what + ", while " +
-                       std::to_string(running_levels.size()) + " case(s) run: " + std::to_string(added) +
+                       std::to_string(unfinished_levels.size()) + " case(s) run or wait: " + std::to_string(added) +
                        " case(s) added");
       }
       return added;

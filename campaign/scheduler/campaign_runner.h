@@ -97,11 +97,11 @@ bool reanalyse_campaign(Store& store, std::int64_t campaign_id);
 /// cases it added to the campaign (0: nothing left to refine).
 /// With [analysis] levels, the next phase of analysis/multi_fidelity.h that adds cases (answer-level rounds,
 /// then the dt check, then the check level); @p what, if given, names the phase.
-/// With @p running_levels (the mesh levels of the cases still running): the same, but only when every running
-/// case is a check-level one (analysis/multi_fidelity.h, rounds_may_overlap), else 0 — the top-up of a worker
-/// that would otherwise wait for the round's last case.
+/// With @p unfinished_levels (the mesh levels of the cases still running or queued): the same, but only when
+/// every one of them is a check-level case (analysis/multi_fidelity.h, rounds_may_overlap), else 0 — the
+/// top-up that lets the next round's cases join a queue of hours-long check-level cases.
 int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir,
-                    std::string* what = nullptr, const std::vector<int>* running_levels = nullptr);
+                    std::string* what = nullptr, const std::vector<int>* unfinished_levels = nullptr);
 
 /// @brief Writes @p text to @p path via a temporary file in the same folder and rename (atomic).
 void write_file_atomic(const std::string& path, const std::string& text);

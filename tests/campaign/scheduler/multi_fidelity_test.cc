@@ -173,7 +173,7 @@ TEST(MultiFidelity, AFreeWorkerTakesTheCheckLevelsNextCaseWhileALongOneRuns) {
   r = sh(campaign_cmd(env + " FAKE_SLOW_CA=0.015 FAKE_SLOW_LEVEL=3 FAKE_SLOW_STEP_S=3", dir + "/mf.toml",
                       dir + "/top_up.db", "--jobs 2"));
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.err.find("round 6, multi-fidelity: mesh check on level 3, while 1 case(s) run: 1 case(s) added"),
+  EXPECT_NE(r.err.find("round 6, multi-fidelity: mesh check on level 3, while 1 case(s) run or wait: 1 case(s) added"),
             std::string::npos) << r.err;
   EXPECT_EQ(rounds(r.err), plain_rounds) << "a top-up round counts towards max_rounds like the others: " << r.err;
   const auto top_up = nlohmann::json::parse(level3(dir + "/top_up.db"));
@@ -182,6 +182,21 @@ TEST(MultiFidelity, AFreeWorkerTakesTheCheckLevelsNextCaseWhileALongOneRuns) {
       << "0.8 starts while 0.015 runs: " << top_up.dump();
   auto table = [&](const std::string& db) { return sh(exe() + " query table1 --db " + db + " --format json").out; };
   EXPECT_EQ(table(dir + "/top_up.db"), table(dir + "/plain.db"));
+
+  // One worker, cheapest first: the check round's six cases are queued, the largest Ca (the cheapest) run first,
+  // and once 0.663 and 0.68 are done the cell calls for 0.8. It joins the queue at once (everything left is a
+  // check-level case) and, the cheapest, runs next — not after the four Ca* check cases (hours each on a real
+  // level 4). The same cases and answers as the plain run.
+  r = sh(campaign_cmd(env, dir + "/mf.toml", dir + "/one.db", "--jobs 1 --order shortest"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(sql(dir + "/one.db", "SELECT c.capillary_number FROM attempts a JOIN cases c USING(case_id) "
+                                 "WHERE c.mesh_level = 3 ORDER BY a.attempt_id"),
+            "0.68\n0.663\n0.8\n0.045\n0.04\n0.018\n0.015\n")
+      << r.err;
+  EXPECT_NE(r.err.find("mesh check on level 3, while 4 case(s) run or wait: 1 case(s) added"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(rounds(r.err), plain_rounds) << r.err;
+  EXPECT_EQ(table(dir + "/one.db"), table(dir + "/plain.db"));
 }
 
 }  // namespace

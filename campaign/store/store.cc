@@ -682,7 +682,11 @@ Table Store::cases_table(const CaseFilter& f) {
   Stmt s(*db_,
          "SELECT c.case_id, c.law, c.aspect_ratio, c.skalak_C, c.mesh_level, c.capillary_number, c.status, "
          "c.attempts, r.min_D12, r.max_tau_min, r.mean_D12, r.period, r.regime, r.volume_drift, r.steps, "
-         "r.dt, r.t_final, coalesce(r.wall_s, c.wall_s) AS wall_s, c.code_version, c.error, c.h5_path "
+         "r.dt, r.t_final, coalesce(r.wall_s, c.wall_s) AS wall_s, "
+         "json_extract(r.raw_json, '$.flow_evaluations') AS flow_evaluations, "
+         "CASE WHEN r.case_id IS NULL THEN NULL ELSE coalesce(json_extract(r.raw_json, '$.threads'), 1) END AS threads, "
+         "r.wall_s * coalesce(json_extract(r.raw_json, '$.threads'), 1) AS core_s, "
+         "c.code_version, c.error, c.h5_path, c.params_json AS params "
          "FROM cases c LEFT JOIN results r ON r.case_id=c.case_id "
          "WHERE (?1 = '' OR c.case_id IN (SELECT cc.case_id FROM campaign_cases cc JOIN campaigns k "
          "ON k.campaign_id=cc.campaign_id WHERE k.name=?1)) "

@@ -3,6 +3,8 @@
 #include <sqlite3.h>
 
 #include "campaign/store/store.h"
+
+#include <nlohmann/json.hpp>
 #include "capsim/schema_sql.h"
 #include "tests/campaign/test_util.h"
 
@@ -99,6 +101,27 @@ TEST(Store, CorruptOrForeignFilesAreRefusedAndNothingIsOverwritten) {
     EXPECT_EQ(q.code, 2) << name << ": " << q.err;
     EXPECT_EQ(read_file(db), before) << name;
     EXPECT_FALSE(fs::exists(db + ".runs")) << name;
+  }
+}
+
+// `query cases` carries each case's cost and keys, so that scripts (compare_campaigns) need no SQL of their own:
+// core_s is the worker's wall × threads, params every key of the case, flow_evaluations the worker's count.
+TEST(Store, QueryCasesGivesTheCostAndTheKeysOfEachCase) {
+  const std::string dir = fresh_dir("store_query_cases");
+  const std::string db = make_db(dir);
+  auto r = sh(exe() + " query cases --db " + db + " --format json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto rows = nlohmann::json::parse(r.out);
+  ASSERT_EQ(rows.size(), 4u) << r.out;
+  for (const auto& c : rows) {
+    ASSERT_EQ(c.at("status"), "done") << c.dump();
+    EXPECT_GE(c.at("threads").get<int>(), 1) << c.dump();
+    EXPECT_NEAR(c.at("core_s").get<double>(), c.at("wall_s").get<double>() * c.at("threads").get<int>(), 1e-9)
+        << c.dump();
+    EXPECT_TRUE(c.contains("flow_evaluations")) << c.dump();
+    const auto p = nlohmann::json::parse(c.at("params").get<std::string>());
+    EXPECT_EQ(p.at("flow.capillary_number").get<double>(), c.at("capillary_number").get<double>()) << c.dump();
+    EXPECT_EQ(p.at("mesh.level").get<int>(), c.at("mesh_level").get<int>()) << c.dump();
   }
 }
 

@@ -5,6 +5,8 @@
 #include "campaign/store/store.h"
 
 #include <nlohmann/json.hpp>
+
+#include "campaign/grid/case_params.h"
 #include "capsim/schema_sql.h"
 #include "tests/campaign/test_util.h"
 
@@ -123,6 +125,24 @@ TEST(Store, QueryCasesGivesTheCostAndTheKeysOfEachCase) {
     EXPECT_EQ(p.at("flow.capillary_number").get<double>(), c.at("capillary_number").get<double>()) << c.dump();
     EXPECT_EQ(p.at("mesh.level").get<int>(), c.at("mesh_level").get<int>()) << c.dump();
   }
+}
+
+// A database written under an earlier cost estimator (est_cost ∝ 1/Ca before 2026-12-05) is ordered by
+// today's once a campaign run opens it: every case's est_cost becomes CaseParams::estimated_cost.
+TEST(Store, ARunRefreshesTheCostEstimatesOfItsCases) {
+  const std::string dir = fresh_dir("store_refresh_estimates");
+  const std::string db = make_db(dir);
+  exec_sql(db, "UPDATE cases SET est_cost = 1");
+  ASSERT_EQ(sh(campaign_cmd("FAKE_STEPS=1", dir + "/tiny.toml", db, "--jobs 1")).code, 0);
+  auto store = Store::open_readonly(db);
+  Stmt s(store->db(), "SELECT params_json, est_cost FROM cases");
+  int n = 0;
+  while (s.step()) {
+    EXPECT_EQ(*s.real(1), CaseParams::from_json(s.text(0)).estimated_cost()) << s.text(0);
+    EXPECT_NE(*s.real(1), 1.0);
+    ++n;
+  }
+  EXPECT_EQ(n, 4);
 }
 
 TEST(Store, SqlQueriesAreReadOnly) {

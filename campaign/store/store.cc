@@ -313,6 +313,11 @@ int Store::add_cases(std::int64_t campaign_id, const std::vector<CaseParams>& ca
   return linked;
 }
 
+// The threads a finished case ran with (results.raw_json; 1 when the worker did not say), and its cost in
+// core-seconds: the one definition of both for the queries below (macros: they join string literals).
+#define CAPSIM_CASE_THREADS "coalesce(json_extract(r.raw_json, '$.threads'), 1)"
+#define CAPSIM_CASE_CORE_S "r.wall_s * " CAPSIM_CASE_THREADS
+
 int Store::refresh_cost_estimates(std::int64_t campaign_id) {
   std::vector<std::pair<std::string, double>> changed;
   {
@@ -689,8 +694,8 @@ Table Store::cases_table(const CaseFilter& f) {
          "c.attempts, r.min_D12, r.max_tau_min, r.mean_D12, r.period, r.regime, r.volume_drift, r.steps, "
          "r.dt, r.t_final, coalesce(r.wall_s, c.wall_s) AS wall_s, "
          "json_extract(r.raw_json, '$.flow_evaluations') AS flow_evaluations, "
-         "CASE WHEN r.case_id IS NULL THEN NULL ELSE coalesce(json_extract(r.raw_json, '$.threads'), 1) END AS threads, "
-         "r.wall_s * coalesce(json_extract(r.raw_json, '$.threads'), 1) AS core_s, "
+         "CASE WHEN r.case_id IS NULL THEN NULL ELSE " CAPSIM_CASE_THREADS " END AS threads, "
+         CAPSIM_CASE_CORE_S " AS core_s, "
          "c.code_version, c.error, c.h5_path, c.params_json AS params "
          "FROM cases c LEFT JOIN results r ON r.case_id=c.case_id "
          "WHERE (?1 = '' OR c.case_id IN (SELECT cc.case_id FROM campaign_cases cc JOIN campaigns k "
@@ -711,7 +716,7 @@ int Store::count_campaign_cases(std::int64_t campaign_id, const std::string& ori
 
 std::vector<Store::FinishedCost> Store::finished_costs(std::int64_t campaign_id) {
   Stmt s(*db_,
-         "SELECT c.mesh_level, c.est_cost, r.wall_s, coalesce(json_extract(r.raw_json, '$.threads'), 1) "
+         "SELECT c.mesh_level, c.est_cost, r.wall_s, " CAPSIM_CASE_THREADS " "
          "FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id JOIN results r ON r.case_id=c.case_id "
          "WHERE cc.campaign_id=? AND c.status IN ('done', 'unstable') AND r.wall_s > 0");
   s.bind(1, campaign_id);
@@ -725,7 +730,7 @@ std::vector<Store::FinishedCost> Store::finished_costs(std::int64_t campaign_id)
 std::vector<Store::LevelCost> Store::level_costs(std::int64_t campaign_id) {
   Stmt s(*db_,
          "SELECT c.mesh_level, count(*), count(r.case_id), "
-         "coalesce(sum(r.wall_s * coalesce(json_extract(r.raw_json, '$.threads'), 1)), 0) "
+         "coalesce(sum(" CAPSIM_CASE_CORE_S "), 0) "
          "FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id LEFT JOIN results r ON r.case_id=c.case_id "
          "WHERE cc.campaign_id=? GROUP BY c.mesh_level ORDER BY c.mesh_level");
   s.bind(1, campaign_id);

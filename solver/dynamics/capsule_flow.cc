@@ -126,6 +126,11 @@ namespace {
 double stable_time_step(double h_min, double capillary_number, double factor) {
   return factor * capillary_number * h_min / (1.0 + kLargeCaCoefficient * capillary_number);
 }
+
+/// The spectral radius RKC chooses its stages for on the reference shape (no prestress), safety included.
+double reference_spectral_radius(const config::CaseConfig& config, double h_min) {
+  return config.rkc_safety * membrane_spectral_radius(h_min, config.capillary_number, 0.0, config.bending_modulus);
+}
 }  // namespace
 
 double automatic_time_step(const mesh::SurfaceMesh& mesh, double capillary_number, double factor) {
@@ -145,19 +150,16 @@ double automatic_time_step(const config::CaseConfig& config, double h_min) {
   // (level 4, κ_b = 0.1: ≈ 600): cap dt so the reference state needs at most half of them, leaving room for
   // the prestress and the shrinking h_min of the deformed states.
   const RkcIntegrator::Options rkc;
-  const double rho =
-      config.rkc_safety * membrane_spectral_radius(h_min, config.capillary_number, 0.0, config.bending_modulus);
-  const double cap = RkcIntegrator::stability_boundary(rkc.max_stages / 2, rkc.damping) / rho;
+  const double cap =
+      RkcIntegrator::stability_boundary(rkc.max_stages / 2, rkc.damping) / reference_spectral_radius(config, h_min);
   return std::min(std::max(config.dt_accuracy, stable), cap);
 }
 
 double evaluations_per_unit_time(const config::CaseConfig& config, double h_min) {
   const double dt = config.dt ? *config.dt : automatic_time_step(config, h_min);
   if (config.scheme != "rkc") return 2.0 / dt;
-  const RkcIntegrator::Options rkc;
-  const double rho =
-      config.rkc_safety * membrane_spectral_radius(h_min, config.capillary_number, 0.0, config.bending_modulus);
-  return RkcIntegrator::stages_for(dt * rho, rkc.damping) / dt;
+  return RkcIntegrator::stages_for(dt * reference_spectral_radius(config, h_min), RkcIntegrator::Options{}.damping) /
+         dt;
 }
 
 }  // namespace capsim::dynamics

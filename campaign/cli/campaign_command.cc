@@ -1,4 +1,4 @@
-// `capsim campaign run|submit|collect|analyse|status`: the campaign manager's command line.
+// `capsim campaign run|submit|collect|import|analyse|status`: the campaign manager's command line.
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
@@ -20,6 +20,7 @@
 #include "campaign/scheduler/progress.h"
 #include "campaign/scheduler/worker_process.h"
 #include "campaign/slurm/slurm.h"
+#include "campaign/store/case_import.h"
 #include "campaign/store/store.h"
 #include "solver/config/case_keys.h"
 #include "solver/io/checkpoint.h"
@@ -113,6 +114,45 @@ int analyse(const std::string& db_path, const std::string& name) {
     if (auto tr = store->transitions(c.campaign_id); done && !tr.empty())
       std::printf("%s", campaign::render(transitions_table(tr), campaign::Format::kMarkdown).c_str());
   }
+  return 0;
+}
+
+// `capsim campaign import`: takes over the cases another database has finished that this one holds unfinished
+// (campaign/store/case_import.h), then recomputes the transitions of the campaigns that gained results, as
+// `analyse` does. It takes the manager lock: not while a manager runs on the database.
+int import_cases(campaign::ImportOptions opt, const std::string& db_path) {
+  namespace fs = std::filesystem;
+  if (!fs::is_regular_file(db_path)) throw BadInput(db_path + ": no such database");
+  if (!fs::is_regular_file(opt.source_path)) throw BadInput(opt.source_path + ": no such database");
+  std::error_code ec;
+  if (fs::equivalent(db_path, opt.source_path, ec))
+    throw BadInput("--from " + opt.source_path + " is the database itself");
+  if (opt.runs_dir.empty()) opt.runs_dir = db_path + ".runs";
+  opt.runs_dir = fs::absolute(opt.runs_dir).string();
+  std::optional<campaign::ManagerLock> lock;
+  if (!opt.dry_run) lock.emplace(db_path);
+  auto source = campaign::Store::open_readonly(opt.source_path);
+  auto target = opt.dry_run ? campaign::Store::open_readonly(db_path) : campaign::Store::open_for_write(db_path);
+  const auto report = campaign::import_finished_cases(*target, *source, opt);
+  double core_s = 0;
+  for (const auto& c : report.imported) {
+    core_s += c.core_s;
+    std::printf("%s %s %s a/b=%s Ca=%s level %d: %s (%s core-h where it ran)%s\n",
+                opt.dry_run ? "would import" : "imported", c.case_id.c_str(), c.law.c_str(),
+                campaign::canonical_double(c.aspect_ratio).c_str(), campaign::canonical_double(c.capillary_number).c_str(),
+                c.mesh_level, c.status.c_str(), campaign::format_significant(c.core_s / 3600.0, 3).c_str(),
+                opt.dry_run || !c.folder.empty() ? "" : "; its case folder was not found, so no time series file");
+  }
+  std::printf("capsim campaign import: %s %zu of %d unfinished case(s) from %s (%s core-h saved); %d not finished "
+              "there%s\n",
+              opt.dry_run ? "would take" : "took", report.imported.size(), report.unfinished, opt.source_path.c_str(),
+              campaign::format_significant(core_s / 3600.0, 3).c_str(), report.not_in_source,
+              report.running ? (", " + std::to_string(report.running) + " running here (left alone)").c_str() : "");
+  if (!opt.dry_run)
+    for (const auto id : report.campaigns) campaign::reanalyse_campaign(*target, id);
+  if (!opt.dry_run && !report.campaigns.empty())
+    std::printf("capsim campaign import: transitions of %zu campaign(s) recomputed; `capsim campaign run` continues "
+                "from here\n", report.campaigns.size());
   return 0;
 }
 
@@ -236,6 +276,17 @@ int campaign_command(const std::vector<std::string>& args) {
   collect->add_option("--db", col.db_path, "SQLite results database")->required();
   collect->add_option("--campaign", col.campaign, "only this campaign");
 
+  campaign::ImportOptions imp;
+  std::string import_db;
+  auto* im = app.add_subcommand("import",
+                                "take over the cases another database has finished that this one holds unfinished "
+                                "(same identity: same parameters and solver version)");
+  im->add_option("--db", import_db, "SQLite results database to import into")->required();
+  im->add_option("--from", imp.source_path, "the other database (read only)")->required();
+  im->add_option("--campaign", imp.campaign, "only cases of this campaign");
+  im->add_option("--runs-dir", imp.runs_dir, "folder the copied case folders go to (default: DB.runs)");
+  im->add_flag("--dry-run", imp.dry_run, "list what would be imported, change nothing");
+
   std::string analyse_db, analyse_name;
   auto* an = app.add_subcommand("analyse",
                                 "recompute the transitions of each campaign (or one) with this build's analysis; runs no case");
@@ -270,6 +321,7 @@ int campaign_command(const std::vector<std::string>& args) {
       return campaign::submit_campaign(sub);
     }
     if (*collect) return campaign::collect_campaign(col);
+    if (*im) return import_cases(imp, import_db);
     if (*an) return analyse(analyse_db, analyse_name);
     return status(status_db, status_name);
   } catch (const BadInput& e) {

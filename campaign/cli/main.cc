@@ -21,6 +21,7 @@ void print_usage() {
       "  capsim campaign submit CAMPAIGN.toml --db FILE [--array-limit K] [--partition P] [--time HH:MM:SS]\n"
       "                         [--cases-per-task M] [--dry-run]\n"
       "  capsim campaign collect --db FILE\n"
+      "  capsim campaign import --db FILE --from OTHER.sqlite [--campaign NAME] [--dry-run]\n"
       "  capsim campaign status --db FILE\n"
       "  capsim query table1|cases|sql ... --db FILE [--format md|csv|json]\n"
       "  capsim bench kernel [--json]\n"

@@ -411,6 +411,45 @@ std::vector<CaseRow> Store::running_cases() {
   return out;
 }
 
+std::optional<FinishedCase> Store::finished_case(const std::string& case_id) {
+  Stmt s(*db_, "SELECT c.case_id, c.status, c.params_json, c.solver_version, r.raw_json, coalesce(c.out_dir,''), "
+               "coalesce(c.h5_path,'') FROM cases c JOIN results r ON r.case_id=c.case_id "
+               "WHERE c.case_id=? AND c.status IN ('done','unstable')");
+  s.bind(1, case_id);
+  if (!s.step()) return std::nullopt;
+  return FinishedCase{s.text(0), s.text(1), s.text(2), s.text(3), s.text(4), s.text(5), s.text(6)};
+}
+
+bool Store::import_result(const FinishedCase& from, const std::string& out_dir, const std::string& h5_path,
+                          const std::string& source) {
+  const auto j = parse_result_line(from.raw_json);
+  if (!j) throw BadInput(source + ": case " + from.case_id + " has no complete result line");
+  Transaction t(*db_);
+  {
+    Stmt q(*db_, "SELECT status FROM cases WHERE case_id=?");
+    q.bind(1, from.case_id);
+    if (!q.step()) return false;
+    const std::string st = q.text(0);
+    if (st != "queued" && st != "failed") return false;
+  }
+  insert_result(*db_, from.case_id, *j, from.raw_json);
+  const std::string status = (*j)["status"].get<std::string>();
+  Stmt u(*db_, std::string("UPDATE cases SET status=?, resumable=0, finished_at=") + kNow +
+                   ", wall_s=(SELECT wall_s FROM results WHERE case_id=?), exit_code=0, "
+                   "code_version=coalesce(?,code_version), error=?, out_dir=?, h5_path=? WHERE case_id=?");
+  u.bind(1, status).bind(2, from.case_id).bind(3, jstr(*j, "code_version"));
+  u.bind(4, status == "unstable" ? SqlValue{result_reason(*j)} : SqlValue{nullptr});
+  u.bind(5, out_dir.empty() ? SqlValue{nullptr} : SqlValue{out_dir});
+  u.bind(6, h5_path.empty() ? SqlValue{nullptr} : SqlValue{h5_path}).bind(7, from.case_id);
+  u.step();
+  Stmt a(*db_, std::string("INSERT INTO attempts(case_id,started_at,finished_at,host,outcome,exit_code,error) "
+                           "VALUES(?,") + kNow + "," + kNow + ",?,'imported',0,?)");
+  a.bind(1, from.case_id).bind(2, host_name()).bind(3, "imported from " + source);
+  a.step();
+  t.commit();
+  return true;
+}
+
 void Store::set_case_folder(const std::string& case_id, const std::string& out_dir) {
   Stmt u(*db_, "UPDATE cases SET out_dir=? WHERE case_id=? AND out_dir IS NOT ?");
   u.bind(1, out_dir).bind(2, case_id).bind(3, out_dir);

@@ -85,6 +85,18 @@ struct CaseFilter {
   std::string status;                 ///< case status
 };
 
+/// @brief A finished case of a database with its result, as another database can take it over (`capsim campaign
+/// import`, case_import.h).
+struct FinishedCase {
+  std::string case_id;         ///< identity
+  std::string status;          ///< done | unstable
+  std::string params_json;     ///< every case key, as stored
+  std::string solver_version;  ///< the version in its identity
+  std::string raw_json;        ///< the worker's result line
+  std::string out_dir;         ///< its case folder as recorded ("" if none)
+  std::string h5_path;         ///< its time series file as recorded ("" if none)
+};
+
 /// @brief The campaign database.
 class Store {
  public:
@@ -133,6 +145,14 @@ class Store {
   std::optional<CaseState> case_state(const std::string& case_id);
   /// @brief Every case with status running (orphans after a manager crash).
   std::vector<CaseRow> running_cases();
+  /// @brief The case @p case_id if this database holds it finished (done or unstable, with its result row).
+  std::optional<FinishedCase> finished_case(const std::string& case_id);
+  /// @brief Records another database's result @p from for the unfinished case of the same identity here (one
+  /// transaction): its results row (the worker's line as is, so its wall time and threads count as the case's
+  /// cost), the case's status, code version and folder @p out_dir / @p h5_path, and an attempt with outcome
+  /// "imported" whose error names @p source. Does nothing and returns false if the case is running or finished here.
+  bool import_result(const FinishedCase& from, const std::string& out_dir, const std::string& h5_path,
+                     const std::string& source);
 
   /// @brief Records the folder a case runs in (prepare_case_folder's choice; recovery and collection read it).
   void set_case_folder(const std::string& case_id, const std::string& out_dir);

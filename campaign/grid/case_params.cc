@@ -129,7 +129,13 @@ double reference_min_spacing(const config::CaseConfig& c) {
 double CaseParams::estimated_cost() const {
   const config::CaseConfig c = config::parse_case_config(to_toml(), "case " + to_json());
   return c.t_end * dynamics::evaluations_per_unit_time(c, reference_min_spacing(c)) *
-         std::pow(kEvaluationCostPerLevel, c.level);
+         std::pow(kEvaluationCostPerLevel, c.level) *
+         (c.kernel_precision == "mixed" ? mixed_precision_cost_factor(c.level) : 1.0);
+}
+
+double CaseParams::mixed_precision_cost_factor(int level) {
+  const double sum = kRegularShareLevel3 * std::pow(16.0, level - 3), rest = std::pow(4.0, level - 3);
+  return (sum / kMixedSumSpeedup + rest) / (sum + rest);
 }
 
 }  // namespace capsim::campaign

@@ -250,6 +250,24 @@ TEST(Identity, JsonRoundTripKeepsIdentity) {
   EXPECT_THROW(CaseParams::from_json("{\"mesh.lvl\": 2}"), BadInput);
 }
 
+// Mixed precision speeds up only the all-pairs sum, whose share of an evaluation grows with the level: the
+// estimate of a mixed case is the double one times the evaluation model's factor, which falls with the level
+// towards 1 / kMixedSumSpeedup, and sits near what `capsim bench flow` measured (0.61 on level 3, 0.45 on 4).
+TEST(CostEstimate, MixedPrecisionScalesTheEstimateByTheEvaluationModel) {
+  for (int level : {2, 3, 4}) {
+    CaseParams d = base(), m = base();
+    d.set("mesh.level", std::int64_t{level});
+    m.set("mesh.level", std::int64_t{level});
+    m.set("numerics.kernel_precision", std::string("mixed"));
+    EXPECT_NEAR(m.estimated_cost() / d.estimated_cost(), CaseParams::mixed_precision_cost_factor(level), 1e-12);
+  }
+  for (int level = 1; level < 8; ++level)
+    EXPECT_LT(CaseParams::mixed_precision_cost_factor(level + 1), CaseParams::mixed_precision_cost_factor(level));
+  EXPECT_NEAR(CaseParams::mixed_precision_cost_factor(10), 1 / CaseParams::kMixedSumSpeedup, 1e-3);
+  EXPECT_NEAR(CaseParams::mixed_precision_cost_factor(3), 0.61, 0.06);
+  EXPECT_NEAR(CaseParams::mixed_precision_cost_factor(4), 0.45, 0.05);
+}
+
 TEST(Grid, CaseTomlHasSections) {
   std::string t = base().to_toml();
   EXPECT_NE(t.find("[flow]\ncapillary_number = 0.3\n"), std::string::npos) << t;

@@ -436,7 +436,7 @@ bool Store::import_result(const FinishedCase& from, const std::string& out_dir, 
   const std::string status = (*j)["status"].get<std::string>();
   Stmt u(*db_, std::string("UPDATE cases SET status=?, resumable=0, finished_at=") + kNow +
                    ", wall_s=(SELECT wall_s FROM results WHERE case_id=?), exit_code=0, "
-                   "code_version=coalesce(?,code_version), error=?, out_dir=?, h5_path=? WHERE case_id=?");
+                   "code_version=coalesce(?,code_version), error=?, out_dir=coalesce(?,out_dir), h5_path=? WHERE case_id=?");
   u.bind(1, status).bind(2, from.case_id).bind(3, jstr(*j, "code_version"));
   u.bind(4, status == "unstable" ? SqlValue{result_reason(*j)} : SqlValue{nullptr});
   u.bind(5, out_dir.empty() ? SqlValue{nullptr} : SqlValue{out_dir});

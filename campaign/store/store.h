@@ -149,7 +149,8 @@ class Store {
   std::optional<FinishedCase> finished_case(const std::string& case_id);
   /// @brief Records another database's result @p from for the unfinished case of the same identity here (one
   /// transaction): its results row (the worker's line as is, so its wall time and threads count as the case's
-  /// cost), the case's status, code version and folder @p out_dir / @p h5_path, and an attempt with outcome
+  /// cost), the case's status, code version and folder @p out_dir (if empty, the folder it had stays) and time
+  /// series file @p h5_path (empty: none; an interrupted attempt's is not the result's), and an attempt with outcome
   /// "imported" whose error names @p source. Does nothing and returns false if the case is running or finished here.
   bool import_result(const FinishedCase& from, const std::string& out_dir, const std::string& h5_path,
                      const std::string& source);

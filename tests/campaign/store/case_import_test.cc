@@ -112,6 +112,24 @@ TEST(CampaignImport, TakesOverTheFinishedCasesOfTheSameIdentityWithTheirResultAn
   EXPECT_NE(again.out.find("took 0 of 0 unfinished case(s)"), std::string::npos) << again.out;
 }
 
+// A database committed without its case folders (or copied from another machine): the result comes without its
+// time series, the command says so, and the target keeps the folder it had for the case.
+TEST(CampaignImport, WithoutTheSourceFoldersTheResultComesAloneAndTheTargetKeepsItsFolder) {
+  const Pair p = make_pair("import_no_folders");
+  const std::string q = "SELECT out_dir FROM cases WHERE capillary_number=0.02";
+  const std::string folder = trimmed(sql(p.target, q));
+  ASSERT_FALSE(folder.empty());
+  fs::rename(p.source + ".runs", p.dir + "/elsewhere");
+  const auto r = sh(import_cmd(p));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(count_lines(r.out), 4) << r.out;  // two cases, the summary, the transitions line
+  EXPECT_NE(r.out.find("its case folder was not found, so no time series file"), std::string::npos) << r.out;
+  EXPECT_EQ(trimmed(sql(p.target, q)), folder);
+  EXPECT_EQ(trimmed(sql(p.target, "SELECT count(*) FROM cases WHERE status='done' AND h5_path IS NULL AND "
+                                  "capillary_number IN (0.02, 0.03)")),
+            "2");
+}
+
 TEST(CampaignImport, AnAlteredSourceCaseRefusesTheWholeImport) {
   const Pair p = make_pair("import_altered");
   // A source row whose parameters no longer hash to its identity (Ca edited by hand).

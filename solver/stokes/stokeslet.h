@@ -119,11 +119,18 @@ void sum_blocks(const double x0[3], const Sources& s, const int* begins, int cou
 /// ≈ h/10 from a node (the Duffy and near-singular phases replace those elements, in double): per target it
 /// stays within kMixedRelativeBound of |u| (tests/solver/stokes/kernel_test.cc), far below the discretisation error;
 /// what it moves in whole cases and campaigns is in results/speed/mixed_ab_case.json and
-/// results/table1_mf_mixed.md. Why it exists: twice the SIMD lanes and a cheaper 1/r (speed-ups in
-/// results/benchmarks.md, "Mixed precision"). Same contract as sum_fast (u overwritten, a source at zero
-/// distance contributes nothing, OpenMP-parallel over targets, each target's sum independent of the thread
-/// count); NaN propagates.
+/// results/table1_mf_mixed.md. Why it exists: twice the SIMD lanes of sum_fast and a cheaper 1/r (speed-ups in
+/// results/benchmarks.md, "Mixed precision"): 16 float lanes where the build has AVX-512, 8 with AVX2. Same
+/// contract as sum_fast (u overwritten, a source at zero distance contributes nothing, OpenMP-parallel over
+/// targets, each target's sum independent of the thread count); NaN propagates. The two widths round
+/// differently (the 1/r estimate and the order of the double sums): a case run on an AVX-512 and on an AVX2
+/// build differs at round-off, as sum_fast's do; the result names mixed_kernel_isa().
 void sum_mixed(const Targets& t, const Sources& s, const Result& u);
+
+/// @brief sum_mixed with 8 float lanes (the AVX2 tile, or the portable loop): on an AVX-512 build the variant
+/// sum_mixed does not use, kept so that `capsim bench kernel` measures both and the tests hold both to the
+/// contract. On other builds it is sum_mixed.
+void sum_mixed_8_lanes(const Targets& t, const Sources& s, const Result& u);
 
 /// @brief Sources a target sums in float before the partial sum is added in double (sum_mixed).
 inline constexpr int kMixedBlock = 256;
@@ -137,8 +144,7 @@ inline constexpr double kMixedRelativeBound = 1e-5;
 /// @brief Contract of sum_fast against the plain double loop: relative difference per target.
 inline constexpr double kFastRelativeBound = 1e-12;
 
-/// @brief Instruction set of sum_mixed in this build: "avx2" (also on AVX-512 machines: 8 float lanes) or
-/// "portable".
+/// @brief Instruction set of sum_mixed in this build: "avx512" (16 float lanes), "avx2" (8) or "portable".
 const char* mixed_kernel_isa();
 
 /// @brief Instruction set of sum_fast in this build: "avx512", "avx2" or "portable".

@@ -136,7 +136,8 @@ TEST(StokesletKernel, ZeroDistanceIsMaskedAndNaNPropagates) {
   using Sum = void (*)(const Targets&, const Sources&, const Result&);
   const std::pair<const char*, Sum> sums[] = {{"fast", [](const Targets& t, const Sources& s, const Result& u) { sum_fast(t, s, u); }},
                                               {"plain", &sum_plain},
-                                              {"mixed", &sum_mixed}};
+                                              {"mixed", &sum_mixed},
+                                              {"mixed, 8 lanes", &sum_mixed_8_lanes}};
   const std::vector<double> sx = {0.0, 1.0}, sy = {0.0, 0.0}, sz = {0.0, 0.0}, q1 = {1.0, 1.0}, q0 = {0.0, 0.0};
   const Sources s{sx.data(), sy.data(), sz.data(), q1.data(), q0.data(), q0.data(), 2};
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -208,20 +209,23 @@ TEST(StokesletKernel, Level2ProblemFastEqualsPlain) {
 // one Newton step ≈ 2e-7) and the positions' rounding (6e-8 absolute) over r ≥ h/10; per target the float
 // partial sums of kMixedBlock terms add at most ≈ kMixedBlock · 6e-8 of their size. kMixedRelativeBound = 1e-5 of |u| at each
 // target holds those with room; the estimate 1/r without its Newton step (error 3.7e-4) or a load rounded to
-// half precision would not. The partial last tile (642 = 40 · 16 + 2 targets) is covered by level 2.
+// half precision would not. The partial last tile (642 = 40 · 16 + 2 = 20 · 32 + 2 targets) is covered by level 2.
+// Both widths are held to it: sum_mixed (16 lanes on an AVX-512 build) and the 8-lane tile.
 TEST(StokesletKernel, MixedPrecisionIsWithinFloatAccuracyOfThePlainSum) {
-  for (const int level : {2, 3}) {
-    const KernelProblem p = make_kernel_problem(level);
-    const int n = p.num_targets();
-    std::vector<double> mx(n), my(n), mz(n), px(n), py(n), pz(n);
-    sum_mixed(p.targets(), p.sources(), {mx.data(), my.data(), mz.data()});
-    sum_plain(p.targets(), p.sources(), {px.data(), py.data(), pz.data()});
-    const double e = max_rel(mx, my, mz, px, py, pz);
-    std::printf("  level %d (%s): mixed vs plain, max relative difference per target %.2e\n", level,
-                mixed_kernel_isa(), e);
-    EXPECT_LT(e, kMixedRelativeBound) << "level " << level;
-    EXPECT_GT(e, 0.0) << "float terms cannot reproduce the double sum exactly";
-  }
+  using Sum = void (*)(const Targets&, const Sources&, const Result&);
+  for (const auto& [name, sum] : {std::pair<const char*, Sum>{"sum_mixed", &sum_mixed}, {"8 lanes", &sum_mixed_8_lanes}})
+    for (const int level : {2, 3}) {
+      const KernelProblem p = make_kernel_problem(level);
+      const int n = p.num_targets();
+      std::vector<double> mx(n), my(n), mz(n), px(n), py(n), pz(n);
+      sum(p.targets(), p.sources(), {mx.data(), my.data(), mz.data()});
+      sum_plain(p.targets(), p.sources(), {px.data(), py.data(), pz.data()});
+      const double e = max_rel(mx, my, mz, px, py, pz);
+      std::printf("  level %d (%s, %s): mixed vs plain, max relative difference per target %.2e\n", level, name,
+                  mixed_kernel_isa(), e);
+      EXPECT_LT(e, kMixedRelativeBound) << name << ", level " << level;
+      EXPECT_GT(e, 0.0) << "float terms cannot reproduce the double sum exactly";
+    }
 }
 
 }  // namespace

@@ -54,6 +54,12 @@ TEST(CommittedResults, MixedPrecisionMultiFidelityTableIsWhatTheDatabaseGives) {
   expect_query_reproduces("table1_mf_mixed.sqlite", "table1_mf_mixed.json", "", 6, true);
 }
 
+// scripts/run itself, timed on an AVX-512 machine (results/main_command_avx512/README.md).
+TEST(CommittedResults, MainCommandRunOnAvx512IsWhatTheDatabaseGives) {
+  expect_query_reproduces("main_command_avx512/table1_mf_mixed.sqlite", "main_command_avx512/table1_mf_mixed.json", "",
+                          6, true);
+}
+
 // The certified campaign shares its database with the multi-fidelity one it continues; the query's default
 // campaign is the most recently run, the certified one.
 TEST(CommittedResults, CertifiedTableIsWhatTheDatabaseGives) {

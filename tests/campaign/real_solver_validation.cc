@@ -50,9 +50,10 @@ TEST(RealSolverValidation, InterruptedCampaignResumesToTheSameResults) {
     EXPECT_EQ(a[i]["case_id"], b[i]["case_id"]);
     EXPECT_EQ(a[i]["status"], b[i]["status"]) << a[i]["case_id"];
     for (const char* k : {"min_D12", "max_tau_min", "t_final"})
-      if (a[i][k].is_number() && b[i][k].is_number())
+      if (a[i][k].is_number() && b[i][k].is_number()) {
         EXPECT_NEAR(a[i][k].get<double>(), b[i][k].get<double>(), 1e-9 * (1 + std::fabs(a[i][k].get<double>())))
             << a[i]["case_id"] << " " << k;
+      }
   }
 }
 

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
 namespace capsim::campaign::testing {
 
@@ -80,6 +81,14 @@ inline CmdResult sh(const std::string& cmd) {
 }
 
 /// The rows of `capsim query sql Q --db DB --format csv`, without the header line; the query must succeed.
+/// Runs SQL that writes on a database directly (what a test does to a database behind the manager's back).
+inline void exec_sql(const std::string& db, const std::string& text) {
+  sqlite3* h = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &h), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(h, text.c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << sqlite3_errmsg(h);
+  sqlite3_close(h);
+}
+
 inline std::string sql(const std::string& db, const std::string& q) {
   auto r = sh(exe() + " query sql \"" + q + "\" --db " + db + " --format csv");
   EXPECT_EQ(r.code, 0) << q << ": " << r.err;

@@ -18,13 +18,6 @@ aspect_ratio = [0.5]
 capillary_number = [0.02, 0.03, 0.04, 0.05]
 )";
 
-void exec_sql(const std::string& db, const std::string& text) {
-  sqlite3* h = nullptr;
-  ASSERT_EQ(sqlite3_open(db.c_str(), &h), SQLITE_OK);
-  ASSERT_EQ(sqlite3_exec(h, text.c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << sqlite3_errmsg(h);
-  sqlite3_close(h);
-}
-
 // The files that differ between two snapshots (the contents are binary: only their names are worth printing).
 std::string changed_files(const std::map<std::string, std::string>& a, const std::map<std::string, std::string>& b) {
   std::string out;

@@ -22,13 +22,6 @@ aspect_ratio = [0.5, 2.0]
 capillary_number = [0.02, 0.03]
 )";
 
-void exec_sql(const std::string& db, const std::string& sql) {
-  sqlite3* h = nullptr;
-  ASSERT_EQ(sqlite3_open(db.c_str(), &h), SQLITE_OK);
-  ASSERT_EQ(sqlite3_exec(h, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << sqlite3_errmsg(h);
-  sqlite3_close(h);
-}
-
 std::string make_db(const std::string& dir) {
   write_file(dir + "/tiny.toml", kTiny);
   auto r = sh(campaign_cmd("FAKE_STEPS=1", dir + "/tiny.toml", dir + "/study.db", "--jobs 2"));

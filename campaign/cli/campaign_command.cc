@@ -133,7 +133,15 @@ int import_cases(campaign::ImportOptions opt, const std::string& db_path) {
   if (!opt.dry_run) lock.emplace(db_path);
   auto source = campaign::Store::open_readonly(opt.source_path);
   auto target = opt.dry_run ? campaign::Store::open_readonly(db_path) : campaign::Store::open_for_write(db_path);
-  const auto report = campaign::import_finished_cases(*target, *source, opt);
+  campaign::ImportReport report;
+  try {
+    report = campaign::import_finished_cases(*target, *source, opt);
+  } catch (const fs::filesystem_error& e) {
+    // A case's files are copied before its row changes: the cases imported so far are complete, the rest untouched.
+    std::fprintf(stderr, "capsim campaign: error: cannot copy a case folder into %s: %s; the cases imported before it "
+                 "stay imported, rerun the command once the folder is writable\n", opt.runs_dir.c_str(), e.what());
+    return kExitWriteFailed;
+  }
   double core_s = 0;
   for (const auto& c : report.imported) {
     core_s += c.core_s;

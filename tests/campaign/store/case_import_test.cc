@@ -123,6 +123,19 @@ TEST(CampaignImport, WithoutTheSourceFoldersTheResultComesAloneAndTheTargetKeeps
             "2");
 }
 
+// A runs folder that cannot be created (its parent is a file): exit 4 with one message, and since a case's files
+// are copied before its row changes, nothing was imported.
+TEST(CampaignImport, AnUnwritableRunsFolderIsAWriteFailureThatChangesNothing) {
+  const Pair p = make_pair("import_unwritable");
+  write_file(p.dir + "/a_file", "x");
+  const auto before = stored_state(p.dir, {p.source, p.target});
+  const auto r = sh(import_cmd(p, "--runs-dir " + p.dir + "/a_file/runs"));
+  EXPECT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.err.find("cannot copy a case folder"), std::string::npos) << r.err;
+  EXPECT_EQ(count_lines(r.err), 1) << r.err;
+  EXPECT_EQ(changed_files(stored_state(p.dir, {p.source, p.target}), before), "");
+}
+
 TEST(CampaignImport, AnAlteredSourceCaseRefusesTheWholeImport) {
   const Pair p = make_pair("import_altered");
   // A source row whose parameters no longer hash to its identity (Ca edited by hand).

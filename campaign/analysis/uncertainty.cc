@@ -115,6 +115,13 @@ LevelCrossing level_answer(const SampleGroup& g2, Answer which, double a, double
   return {crossing(*in, *y_in, *out, *y_out, thr), false};
 }
 
+// Whether g has a value of q at Ca c (a finished case there that recorded it).
+bool has_value_at(const SampleGroup& g, Quantity q, double c) {
+  for (const auto& s : g.samples)
+    if (same_ca(s.ca, c) && value(s, q)) return true;
+  return false;
+}
+
 // The largest |q_L2(c) − q_L(c)| over the bracket Ca c ∈ {a, b}: q_L2(c) taken at c where g2 has a sample
 // there (a check level run at the brackets), else interpolated linearly between g2's nearest samples on either
 // side of c (a level sampled elsewhere); nullopt where g2's samples do not span c.
@@ -165,6 +172,10 @@ Part mesh_part(const Cell& cell, int level, Answer which, double a, double b, do
   auto take = [&](int l, std::optional<double>& out) {
     auto it = cell.by_level.find(l);
     if (it == cell.by_level.end()) return;
+    // A finer (check) level is run at the answer level's brackets. Until it has values at both, what it says
+    // here is pending: its own bracket elsewhere (an oblate cell's level 4 at Ca 0.02 and 0.5, a line across 0.48
+    // in Ca) or its values interpolated across such a gap are not an answer of that level near this one.
+    if (l > level && !(has_value_at(*it->second, q, a) && has_value_at(*it->second, q, b))) return;
     const LevelCrossing c = level_answer(*it->second, which, a, b, thr, l > level ? cell.by_level.at(level) : nullptr);
     out = c.ca;
     if (!out) {

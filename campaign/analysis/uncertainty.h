@@ -16,7 +16,9 @@
 ///   check level run at the brackets; where they do not straddle, the finer level's crossing in its own
 ///   bracket beyond them when it has one — check_level_cases runs it outwards until it does — else
 ///   extrapolated), else its own answer from its own bracket (a scan level sampled elsewhere; comparing answers, not values interpolated across a coarse
-///   grid, keeps the V of min D12 from posing as a mesh error). With both neighbours and monotone
+///   grid, keeps the V of min D12 from posing as a mesh error). A finer level without values at both bracket Ca
+///   is pending for that answer and does not enter it (its cases at the bracket are still to run: its own
+///   bracket elsewhere, e.g. two far samples of other answers of the cell, says nothing about this one). With both neighbours and monotone
 ///   differences d₁ = A_L − A_{L−1}, d₂ = A_{L+1} − A_L (same sign, |d₂| < |d₁|): Richardson with the observed
 ///   ratio r = d₂/d₁, e = |d₂| / (1 − r) (the distance from A_L to the extrapolated limit; observed order
 ///   p = log₂(1/r) since each level halves h). Otherwise the difference to the finer level |d₂|, or, with

@@ -192,6 +192,29 @@ TEST(Uncertainty, ACheckLevelBeyondTheBracketAnswersInItsOwnBracket) {
     }
 }
 
+// Found on the certified Table 1: the oblate NH upper Ca* edge (level-3 bracket 0.05 / 0.055) had level-4 cases
+// only at 0.02 (another edge's) and 0.5 (the CaH's), and took level 4's "own answer" from the line across them.
+// A check level without values at both bracket Ca is pending for that answer: the mesh part stays levels 2-3.
+TEST(Uncertainty, ACheckLevelWithoutTheBracketCasesIsPendingNotAnAnswer) {
+  auto d12 = [](double shift) { return [shift](double ca) { return 0.02 + 2.0 * std::fabs(ca - 0.03) + shift; }; };
+  std::vector<CaseSample> cases;
+  add(cases, {.level = 2, .ca = {0.01, 0.02, 0.03, 0.04, 0.05, 0.06}, .d12 = d12(0.004)});
+  add(cases, {.level = 3, .ca = {0.01, 0.02, 0.03, 0.04, 0.045, 0.05}, .d12 = d12(0)});
+  const auto two = analyse(cases, {2, 3, 4});
+  ASSERT_TRUE(two.at(3).ca_star_high_err);
+  // Level 4 far from the upper bracket (0.04, 0.045): inside the band at 0.02, far outside at 0.5.
+  add(cases, {.level = 4, .ca = {0.02, 0.5}, .d12 = d12(-0.01)});
+  const auto a = analyse(cases, {2, 3, 4});
+  EXPECT_EQ(a.at(3).level_answers.count("ca_star_high") ? a.at(3).level_answers.at("ca_star_high").count(4) : 0u, 0u);
+  ASSERT_TRUE(a.at(3).ca_star_high_err);
+  EXPECT_DOUBLE_EQ(*a.at(3).ca_star_high_err, *two.at(3).ca_star_high_err);
+  // Once level 4 has both bracket cases it answers there.
+  add(cases, {.level = 4, .ca = {0.04, 0.045}, .d12 = d12(-0.01)});
+  const auto b = analyse(cases, {2, 3, 4});
+  ASSERT_EQ(b.at(3).level_answers.count("ca_star_high"), 1u);
+  EXPECT_EQ(b.at(3).level_answers.at("ca_star_high").count(4), 1u);
+}
+
 TEST(Uncertainty, TheLargestPartIsCarriedAndNamed) {
   std::vector<CaseSample> cases;
   // Periods: max τmin moves by 0.03 between periods; mesh difference 0.01; slope 2 → 0.015 in Ca.

@@ -82,7 +82,7 @@ std::optional<double> crossing(double a, double ya, double b, double yb, double 
 // through g2's values at a and b when g2 has both (a check level run at the brackets; for a level finer than
 // the answer group `finer_than`, check_level_crossing: its own bracket beyond them at the answer level's
 // samples where they do not straddle), else g2's own answer from
-// its own bracket (a scan level sampled elsewhere). `extrapolated`: a line through g2's values at a and b
+// its own bracket (a coarser scan level sampled elsewhere; mesh_part does not ask a finer level that lacks a or b). `extrapolated`: a line through g2's values at a and b
 // that does not straddle the target.
 LevelCrossing level_answer(const SampleGroup& g2, Answer which, double a, double b, double thr,
                            const SampleGroup* finer_than) {

@@ -6,7 +6,6 @@
 #include <system_error>
 
 #include "campaign/common/bad_input.h"
-#include "solver/driver/case_summary.h"
 
 namespace capsim::campaign {
 
@@ -14,15 +13,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A candidate that passed its checks: the source's case and what the import will do with it.
+// A candidate that passed its checks: the source's case and its parameters.
 struct Candidate {
   FinishedCase from;
   CaseParams params;
-  double core_s = 0;
 };
 
 // Why @p from may not be taken over for @p id, or "" if it may.
-std::string check_candidate(const FinishedCase& from, const std::string& id, CaseParams& params, double& core_s) {
+std::string check_candidate(const FinishedCase& from, const std::string& id, CaseParams& params) {
   try {
     params = CaseParams::from_json(from.params_json);
     if (params.identity(from.solver_version) != id)
@@ -33,8 +31,6 @@ std::string check_candidate(const FinishedCase& from, const std::string& id, Cas
   const auto j = parse_result_line(from.raw_json);
   if (!j) return "its result line is not a complete result";
   if (auto m = result_mismatch(*j, params); !m.empty()) return "its result names other parameters: " + m;
-  const driver::CaseSummary s = driver::CaseSummary::from_json(*j);
-  core_s = s.wall_s * (s.threads > 0 ? s.threads : 1);
   return "";
 }
 
@@ -92,8 +88,8 @@ ImportReport import_finished_cases(Store& target, Store& source, const ImportOpt
         ++report.not_in_source;
         continue;
       }
-      Candidate k{*from, {}, 0};
-      if (auto why = check_candidate(k.from, row.case_id, k.params, k.core_s); !why.empty())
+      Candidate k{*from, {}};
+      if (auto why = check_candidate(k.from, row.case_id, k.params); !why.empty())
         throw BadInput(options.source_path + ": case " + row.case_id + " cannot be imported: " + why +
                        "; nothing was imported");
       candidates.push_back(std::move(k));
@@ -102,7 +98,7 @@ ImportReport import_finished_cases(Store& target, Store& source, const ImportOpt
   std::set<std::string> imported_ids;
   for (const auto& k : candidates) {
     ImportedCase out{k.from.case_id,        k.params.law(), k.from.status, k.params.aspect_ratio(),
-                     k.params.capillary_number(), k.params.mesh_level(), "", k.core_s};
+                     k.params.capillary_number(), k.params.mesh_level(), "", k.from.core_s};
     if (!options.dry_run) {
       std::string h5;
       if (const auto src = source_folder(k.from, options.source_path)) std::tie(out.folder, h5) =

@@ -413,11 +413,12 @@ std::vector<CaseRow> Store::running_cases() {
 
 std::optional<FinishedCase> Store::finished_case(const std::string& case_id) {
   Stmt s(*db_, "SELECT c.case_id, c.status, c.params_json, c.solver_version, r.raw_json, coalesce(c.out_dir,''), "
-               "coalesce(c.h5_path,'') FROM cases c JOIN results r ON r.case_id=c.case_id "
-               "WHERE c.case_id=? AND c.status IN ('done','unstable')");
+               "coalesce(c.h5_path,''), coalesce(" CAPSIM_CASE_CORE_S ", 0) FROM cases c JOIN results r ON "
+               "r.case_id=c.case_id WHERE c.case_id=? AND c.status IN ('done','unstable')");
   s.bind(1, case_id);
   if (!s.step()) return std::nullopt;
-  return FinishedCase{s.text(0), s.text(1), s.text(2), s.text(3), s.text(4), s.text(5), s.text(6)};
+  return FinishedCase{s.text(0), s.text(1), s.text(2), s.text(3), s.text(4), s.text(5), s.text(6),
+                      s.real(7).value_or(0.0)};
 }
 
 bool Store::import_result(const FinishedCase& from, const std::string& out_dir, const std::string& h5_path,

@@ -95,6 +95,7 @@ struct FinishedCase {
   std::string raw_json;        ///< the worker's result line
   std::string out_dir;         ///< its case folder as recorded ("" if none)
   std::string h5_path;         ///< its time series file as recorded ("" if none)
+  double core_s = 0;           ///< what it cost where it ran (worker wall × threads, as `capsim query cases`)
 };
 
 /// @brief The campaign database.

@@ -124,7 +124,8 @@ void sum_blocks(const double x0[3], const Sources& s, const int* begins, int cou
 /// contract as sum_fast (u overwritten, a source at zero distance contributes nothing, OpenMP-parallel over
 /// targets, each target's sum independent of the thread count); NaN propagates. The two widths round
 /// differently (the 1/r estimate and the order of the double sums): a case run on an AVX-512 and on an AVX2
-/// build differs at round-off, as sum_fast's do; the result names mixed_kernel_isa().
+/// build differs at round-off, as sum_fast's do; a result's kernel_isa names the build's instruction set (both
+/// kernels follow the same one).
 void sum_mixed(const Targets& t, const Sources& s, const Result& u);
 
 /// @brief sum_mixed with 8 float lanes (the AVX2 tile, or the portable loop): on an AVX-512 build the variant

@@ -252,7 +252,8 @@ TEST(Identity, JsonRoundTripKeepsIdentity) {
 
 // Mixed precision speeds up only the all-pairs sum, whose share of an evaluation grows with the level: the
 // estimate of a mixed case is the double one times the evaluation model's factor, which falls with the level
-// towards 1 / kMixedSumSpeedup, and sits near what `capsim bench flow` measured (0.61 on level 3, 0.45 on 4).
+// towards 1 / kMixedSumSpeedup. (How near it is to what `capsim bench flow` measures is a measurement: the
+// header and results/benchmarks.md, not a test.)
 TEST(CostEstimate, MixedPrecisionScalesTheEstimateByTheEvaluationModel) {
   for (int level : {2, 3, 4}) {
     CaseParams d = base(), m = base();
@@ -264,8 +265,7 @@ TEST(CostEstimate, MixedPrecisionScalesTheEstimateByTheEvaluationModel) {
   for (int level = 1; level < 8; ++level)
     EXPECT_LT(CaseParams::mixed_precision_cost_factor(level + 1), CaseParams::mixed_precision_cost_factor(level));
   EXPECT_NEAR(CaseParams::mixed_precision_cost_factor(10), 1 / CaseParams::kMixedSumSpeedup, 1e-3);
-  EXPECT_NEAR(CaseParams::mixed_precision_cost_factor(3), 0.61, 0.06);
-  EXPECT_NEAR(CaseParams::mixed_precision_cost_factor(4), 0.45, 0.05);
+  EXPECT_NEAR(CaseParams::mixed_precision_cost_factor(-10), 1.0, 1e-3);  // tiny meshes: the O(N) rest dominates
 }
 
 TEST(Grid, CaseTomlHasSections) {

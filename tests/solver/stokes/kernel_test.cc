@@ -221,8 +221,8 @@ TEST(StokesletKernel, MixedPrecisionIsWithinFloatAccuracyOfThePlainSum) {
       sum(p.targets(), p.sources(), {mx.data(), my.data(), mz.data()});
       sum_plain(p.targets(), p.sources(), {px.data(), py.data(), pz.data()});
       const double e = max_rel(mx, my, mz, px, py, pz);
-      std::printf("  level %d (%s, %s): mixed vs plain, max relative difference per target %.2e\n", level, name,
-                  mixed_kernel_isa(), e);
+      std::printf("  level %d (%s; sum_mixed is %s here): mixed vs plain, max relative difference per target %.2e\n",
+                  level, name, mixed_kernel_isa(), e);
       EXPECT_LT(e, kMixedRelativeBound) << name << ", level " << level;
       EXPECT_GT(e, 0.0) << "float terms cannot reproduce the double sum exactly";
     }

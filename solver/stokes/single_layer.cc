@@ -20,6 +20,67 @@ bool fail(std::string* why, const std::string& message) {
   return false;
 }
 
+// The Duffy integral of one element with the target at the apex of the table, in single precision
+// (KernelPrecision::Mixed), added to acc. C and D: the element's position (only C1..C5 are read: the apex is
+// the target, so the re-expanded constant term is 0) and its load in monomial form about (ξ, η) = (0, 0)
+// (mesh::p2_monomials), re-expanded here in double about the apex P, so
+// that the float loop works with coordinates (u, v) relative to P and a position d that vanishes at P exactly:
+// next to the apex, where the points crowd and the terms are largest, d keeps its float relative accuracy
+// instead of inheriting the cancellation of C0 + ... against a far origin. The terms are summed in float over
+// chunks of kDuffyChunk points (one 8 × 8 Duffy square) and the chunk sums in double, as kernel::sum_mixed
+// sums blocks of sources.
+constexpr int kDuffyChunk = 64;
+
+void duffy_mixed(const ApexTableF& tb, const double C[6][3], const double D[6][3], double acc[3]) {
+  const double a = tb.apex_xi, b = tb.apex_eta;
+  float c[6][3], f[6][3];  // shifted coefficients: g(u, v) = c0 + c1 u + c2 v + c3 u² + c4 u v + c5 v²
+  for (int k = 0; k < 3; ++k) {
+    c[0][k] = 0.0f;  // the target is the apex node: its relative position is exactly 0
+    c[1][k] = static_cast<float>(C[1][k] + 2.0 * C[3][k] * a + C[4][k] * b);
+    c[2][k] = static_cast<float>(C[2][k] + C[4][k] * a + 2.0 * C[5][k] * b);
+    c[3][k] = static_cast<float>(C[3][k]);
+    c[4][k] = static_cast<float>(C[4][k]);
+    c[5][k] = static_cast<float>(C[5][k]);
+    f[0][k] = static_cast<float>(D[0][k] + a * (D[1][k] + a * D[3][k] + b * D[4][k]) + b * (D[2][k] + b * D[5][k]));
+    f[1][k] = static_cast<float>(D[1][k] + 2.0 * D[3][k] * a + D[4][k] * b);
+    f[2][k] = static_cast<float>(D[2][k] + D[4][k] * a + 2.0 * D[5][k] * b);
+    f[3][k] = static_cast<float>(D[3][k]);
+    f[4][k] = static_cast<float>(D[4][k]);
+    f[5][k] = static_cast<float>(D[5][k]);
+  }
+  const float *pu = tb.u.data(), *pv = tb.v.data(), *wt = tb.w.data();
+  double sx = 0.0, sy = 0.0, sz = 0.0;
+  for (int p0 = 0; p0 < tb.count; p0 += kDuffyChunk) {
+    const int p1 = std::min(tb.count, p0 + kDuffyChunk);
+    float fx = 0.0f, fy = 0.0f, fz = 0.0f;
+#pragma omp simd reduction(+ : fx, fy, fz)
+    for (int p = p0; p < p1; ++p) {
+      const float u = pu[p], v = pv[p];
+      float d[3], t1[3], t2[3], qq[3];
+      for (int k = 0; k < 3; ++k) {
+        const float e = c[1][k] + u * c[3][k] + v * c[4][k], g = c[2][k] + v * c[5][k];
+        d[k] = u * e + v * g;
+        t1[k] = e + u * c[3][k];
+        t2[k] = g + u * c[4][k] + v * c[5][k];
+        qq[k] = f[0][k] + u * (f[1][k] + u * f[3][k] + v * f[4][k]) + v * (f[2][k] + v * f[5][k]);
+      }
+      const float nx = t1[1] * t2[2] - t1[2] * t2[1], ny = t1[2] * t2[0] - t1[0] * t2[2],
+                  nz = t1[0] * t2[1] - t1[1] * t2[0];
+      const float nn = nx * nx + ny * ny + nz * nz;
+      const float r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+      // As in the double loop: with s = (nn r²)^(−1/2), w |t1 × t2| / |r| = w nn s and 1/r² = nn s².
+      const float s = kernel::rsqrt_arith(nn * r2), ns = nn * s;
+      kernel::add_stokeslet_scaled(-d[0], -d[1], -d[2], qq[0], qq[1], qq[2], ns * s, wt[p] * ns, fx, fy, fz);
+    }
+    sx += fx;
+    sy += fy;
+    sz += fz;
+  }
+  acc[0] += sx;
+  acc[1] += sy;
+  acc[2] += sz;
+}
+
 }  // namespace
 
 bool SingleLayerOptions::valid(std::string* why) const {
@@ -50,6 +111,8 @@ SingleLayer::SingleLayer(const mesh::SurfaceMesh& mesh, const SingleLayerOptions
   regular_.assign(regular.points().begin(), regular.points().end());
   rule_size_ = static_cast<int>(regular_.size());
   for (int l = 0; l < 6; ++l) duffy_[l] = make_point_table(duffy_rule(l, opt_.duffy_order));
+  if (uses_mixed_corrections())
+    for (int l = 0; l < 6; ++l) duffy_f_[l] = make_apex_table(l, opt_.duffy_order);
   if (opt_.near_subdivision > 0) {
     near_rule_ = replace_rule(subdivided_rule(opt_.near_subdivision, opt_.near_degree), regular_);
     // Padded with zero-weight points (zero load, at the centroid) to whole SIMD vectors: kernel::sum_blocks.
@@ -179,6 +242,26 @@ void SingleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Ma
   const SourceArrays& reg = *regular_points_;
   const int stride = regular_stride_;
   const int* slot = regular_slot_;
+  const bool mixed = uses_mixed_corrections();
+  if (mixed) {
+    // The monomials of every element's position and load, once per call instead of once per (target,
+    // element) pair: in duffy_mixed only C1..C5 of the position enter (the apex is the target), and those do
+    // not depend on the target.
+    const int ne = num_elements();
+    element_monomials_.resize(static_cast<std::size_t>(ne) * 36);
+#pragma omp parallel for schedule(static)
+    for (int e = 0; e < ne; ++e) {
+      double X[6][3], F[6][3];
+      for (int a = 0; a < 6; ++a)
+        for (int c = 0; c < 3; ++c) {
+          X[a][c] = x(c, elements_[e][a]);
+          F[a][c] = q(c, elements_[e][a]);
+        }
+      double* m = element_monomials_.data() + static_cast<std::size_t>(e) * 36;
+      mesh::p2_monomials3(X, reinterpret_cast<double(*)[3]>(m));
+      mesh::p2_monomials3(F, reinterpret_cast<double(*)[3]>(m + 18));
+    }
+  }
 #pragma omp parallel for schedule(dynamic, 16)
   for (int it = 0; it < nt; ++it) {
     const int i = target_ids_[it];
@@ -192,6 +275,12 @@ void SingleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Ma
       add_block(x0, reg, b, b + nq, -1.0, acc);
       // ... and add the Duffy integral with the node at the apex. Positions relative to x0 (Σ N_a = 1)
       // avoid cancellation near the apex; geometry and load in monomial form (mesh::p2_monomials).
+      if (mixed) {
+        const double* m = element_monomials_.data() + static_cast<std::size_t>(e) * 36;
+        duffy_mixed(duffy_f_[l], reinterpret_cast<const double(*)[3]>(m),
+                    reinterpret_cast<const double(*)[3]>(m + 18), acc);
+        continue;
+      }
       double C[6][3], D[6][3];
       for (int c = 0; c < 3; ++c) {
         double r[6], f[6], cr[6], cf[6];

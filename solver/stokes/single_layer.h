@@ -70,11 +70,13 @@ enum class Symmetry {
 /// @brief Which Stokeslet sum the regular part uses.
 enum class KernelChoice { Fast, Plain };
 
-/// @brief Working precision of the regular part's pair terms (numerics.kernel_precision). Double: every
-/// phase in double. Mixed: the all-pairs regular (or far-field coarse) sum by kernel::sum_mixed — pair terms
-/// in float, sums in double (its error: kernel::sum_mixed) — while the singular, near-singular and far-field corrections,
-/// which hold the large terms of the elements next to each target, stay in double. Ignored with
-/// KernelChoice::Plain (the reference).
+/// @brief Working precision of the pair terms (numerics.kernel_precision). Double: every phase in double.
+/// Mixed: the all-pairs regular (or far-field coarse) sum by kernel::sum_mixed — pair terms in float, sums in
+/// double (its error: kernel::sum_mixed) — and the Duffy integrals of the singular correction in float too,
+/// on coordinates relative to the target (so a term next to it keeps float's relative accuracy; summed in
+/// float per Duffy square, in double across), while the subtraction of the regular rule from those elements and
+/// the near-singular and far-field corrections stay in double (they work on absolute positions, where float
+/// rounding would cost 6e-8/r relative next to the target). Ignored with KernelChoice::Plain (the reference).
 enum class KernelPrecision { Double, Mixed };
 
 /// @brief Options of the single-layer operator.
@@ -160,6 +162,10 @@ class SingleLayer {
   void singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q);
   void near_correction(Eigen::Matrix3Xd& u);
   void mirror(Eigen::Matrix3Xd& u) const;
+  // Whether the Duffy terms are summed in float (KernelPrecision::Mixed with the fast kernel).
+  [[nodiscard]] bool uses_mixed_corrections() const {
+    return opt_.precision == KernelPrecision::Mixed && opt_.kernel == KernelChoice::Fast;
+  }
 
   SingleLayerOptions opt_;
   int num_nodes_ = 0;
@@ -171,6 +177,7 @@ class SingleLayer {
   std::vector<int> node_order_;             // nodes in the order targets are evaluated (spatially coherent)
   std::vector<mesh::P2Point> regular_;      // rule points
   PointTable duffy_[6];                     // Duffy rule per local node position (SoA)
+  ApexTableF duffy_f_[6];                   // the same in float about the apex (mixed precision only)
   std::vector<mesh::P2Point> near_rule_;    // subdivided rule, then the regular rule negated (empty if off)
   NearSingularElements near_;               // node → near-singular elements (empty if off)
   std::vector<int> near_begin_;             // first near point of each entry of near_.elements
@@ -181,6 +188,7 @@ class SingleLayer {
   SourceArrays near_points_;                // near-rule points, element-major
   SourceArrays mid_points_;                 // mid-rule points, block per element in slot order (far tier)
   AlignedVector tx_, ty_, tz_, ux_, uy_, uz_;
+  AlignedVector element_monomials_;         // mixed Duffy: per element 6×3 position, 6×3 load monomials
   FarFieldGrid grid_;                       // far tier geometry of the current call
   MidScratch mid_scratch_;                  // per-thread scratch of the far tier
   // Where the singular correction finds each element's regular points: SoA, block stride, slot (or null).

@@ -60,4 +60,17 @@ PointTable make_point_table(const std::vector<mesh::P2Point>& rule) {
   return t;
 }
 
+ApexTableF make_apex_table(int local, int order) {
+  ApexTableF t;
+  t.apex_xi = kRefNode[local][0];
+  t.apex_eta = kRefNode[local][1];
+  for (const mesh::P2Point& p : duffy_rule(local, order)) {
+    t.u.push_back(static_cast<float>(p.xi - t.apex_xi));
+    t.v.push_back(static_cast<float>(p.eta - t.apex_eta));
+    t.w.push_back(static_cast<float>(p.w));
+  }
+  t.count = static_cast<int>(t.w.size());
+  return t;
+}
+
 }  // namespace capsim::stokes

@@ -31,4 +31,17 @@ struct PointTable {
 /// @brief The SoA table of a rule.
 PointTable make_point_table(const std::vector<mesh::P2Point>& rule);
 
+/// @brief A Duffy rule in single precision for the mixed-precision correction (SingleLayerOptions::precision):
+/// the points relative to the apex, (u, v) = (ξ − ξ_P, η − η_P), and the weights. Relative coordinates keep
+/// the float terms accurate next to the apex, where the points crowd: a point at distance s from P is known
+/// to ≈ 6e-8 · s, not 6e-8 (the element's monomials are re-expanded about P in double before rounding).
+struct ApexTableF {
+  int count = 0;
+  double apex_xi = 0, apex_eta = 0;  ///< (ξ_P, η_P) of the local node at the apex
+  std::vector<float, AlignedAllocator<float>> u, v, w;
+};
+
+/// @brief The single-precision apex table of duffy_rule(local, order).
+ApexTableF make_apex_table(int local, int order);
+
 }  // namespace capsim::stokes

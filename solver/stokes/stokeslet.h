@@ -116,7 +116,8 @@ void sum_blocks(const double x0[3], const Sources& s, const int* begins, int cou
 /// ≈ 2e-7); each target accumulates its terms in float over blocks of kMixedBlock sources and adds the block
 /// sums in double. Why it is accurate enough: the rounding of the positions (≈ 6e-8 absolute for a capsule
 /// of size 1) changes a term at distance r by ≈ 6e-8/r relative, and the regular sum never sees r below
-/// ≈ h/10 from a node (the Duffy and near-singular phases replace those elements, in double): per target it
+/// ≈ h/10 from a node (the Duffy and near-singular phases replace those elements; the Duffy one in float on
+/// coordinates relative to the target, stokes::KernelPrecision): per target it
 /// stays within kMixedRelativeBound of |u| (tests/solver/stokes/kernel_test.cc), far below the discretisation error;
 /// what it moves in whole cases and campaigns is in results/speed/mixed_ab_case.json and
 /// results/table1_mf_mixed.md. Why it exists: twice the SIMD lanes of sum_fast and a cheaper 1/r (speed-ups in
@@ -167,11 +168,26 @@ inline double rsqrt_arith(double x) {
   return y;
 }
 
+/// @brief 1/√x in single precision for a positive normal x, with arithmetic only (the float twin of the double
+/// rsqrt_arith, for `omp simd` loops of the mixed-precision corrections): a bit-level first guess (relative
+/// error ≤ 3.5%), one Householder step of order 3 (→ ≤ 1e-4) and one Newton step (→ ≈ 2e-8, below float
+/// rounding; tests/solver/stokes/kernel_test.cc). x = 0 gives a large finite garbage value: mask it. NaN
+/// propagates.
+inline float rsqrt_arith(float x) {
+  float y = std::bit_cast<float>(std::uint32_t{0x5F375A86} - (std::bit_cast<std::uint32_t>(x) >> 1));
+  float e = 1.0f - x * y * y;
+  y += y * e * (0.5f + e * 0.375f);
+  e = 1.0f - x * y * y;
+  y += y * e * 0.5f;
+  return y;
+}
+
 /// @brief The Stokeslet applied to a load, the one scalar definition used by every non-SIMD path:
 ///     u += f · (q + r (r·q) / r²),   i.e. u += w · J(r)·q with f = w / |r|,   r = x0 − x,
 /// with inv_r2 = 1/r² and f supplied by the caller (each caller chooses how to compute them; inv_r2 = f = 0
 /// masks a pair at zero distance). (r·q) · inv_r2 is the operation order of the SIMD tiles in stokeslet.cc.
-/// T is double (inside `omp simd` loops, where it vectorises once inlined) or long double (test references).
+/// T is double or float (inside `omp simd` loops, where it vectorises once inlined) or long double (test
+/// references).
 template <class T>
 inline void add_stokeslet_scaled(T rx, T ry, T rz, T qx, T qy, T qz, T inv_r2, T f, T& ux, T& uy, T& uz) {
   const T s = (rx * qx + ry * qy + rz * qz) * inv_r2;

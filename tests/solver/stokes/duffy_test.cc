@@ -119,9 +119,15 @@ TEST(DuffyIntegral, MatchesAdaptiveReferenceOnCurvedElement) {
       worst = std::max(worst, err);
       if (order == 16) std::printf("  node %d (%s): |ref| %.6f, rel error %.2e (%ld reference evaluations)\n", l,
                                    l < 3 ? "corner" : "mid-side", ref.norm(), err, evals);
-      if (order == 16) EXPECT_LT(err, 1e-12) << "local node " << l;
-      if (order == 10) EXPECT_LT(err, 1e-8) << "local node " << l;
-      if (order == 6) EXPECT_LT(err, 1e-5) << "local node " << l;  // on a level-0 element (the default is 8)
+      if (order == 16) {
+        EXPECT_LT(err, 1e-12) << "local node " << l;
+      }
+      if (order == 10) {
+        EXPECT_LT(err, 1e-8) << "local node " << l;
+      }
+      if (order == 6) {  // on a level-0 element (the default is 8)
+        EXPECT_LT(err, 1e-5) << "local node " << l;
+      }
     }
     std::printf("  Duffy order %2d: worst rel error over the 6 nodes %.2e\n", order, worst);
   }

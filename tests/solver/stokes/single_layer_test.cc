@@ -115,7 +115,9 @@ TEST(SingleLayer, SymmetricEvaluationEqualsFullEvaluation) {
   EXPECT_LT(diff, 1e-13);
   // u3 vanishes on the mirror plane in both.
   for (int i = 0; i < m.num_nodes(); ++i)
-    if (m.mirror_node[i] == i) EXPECT_LT(std::abs(us(2, i)), 1e-12 * scale);
+    if (m.mirror_node[i] == i) {
+      EXPECT_LT(std::abs(us(2, i)), 1e-12 * scale);
+    }
 }
 
 TEST(SingleLayer, SymmetryIsSkippedForAnAsymmetricScene) {
@@ -353,7 +355,9 @@ TEST(SingleLayerFarField, UniformLoadOnSphereStillGivesStokesDrag) {
       o.far_degree = degree;
       const double err = uniform_load_error(level, o);
       std::printf("  level %d far_degree %d: max rel error %.3e (full rule %.3e)\n", level, degree, err, full);
-      if (degree == 2) EXPECT_LT(err, 2.0 * full) << "level " << level;
+      if (degree == 2) {
+        EXPECT_LT(err, 2.0 * full) << "level " << level;
+      }
       if (degree == 1) coarse_err.push_back(err);
     }
   }

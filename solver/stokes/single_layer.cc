@@ -100,6 +100,7 @@ bool SingleLayerOptions::valid(std::string* why) const {
   if (!(far_radius > 1.0) || !std::isfinite(far_radius))
     return fail(why, "far_radius must be a finite number > 1, got " + std::to_string(far_radius));
   if (!(symmetry_tol >= 0.0)) return fail(why, "symmetry_tol must be >= 0");
+  if (!(load_symmetry_tol >= 0.0)) return fail(why, "load_symmetry_tol must be >= 0");
   if (fast.block < 1 || fast.block > 4) return fail(why, "fast.block must be 1..4, got " + std::to_string(fast.block));
   return true;
 }
@@ -170,7 +171,7 @@ bool SingleLayer::is_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd
   if (mirror_.empty() || x.cols() != num_nodes_ || q.cols() != num_nodes_) return false;
   const double lx = (x.rowwise().maxCoeff() - x.rowwise().minCoeff()).norm();
   const double lq = q.colwise().norm().maxCoeff();
-  const double tx = opt_.symmetry_tol * lx, tq = opt_.symmetry_tol * lq;
+  const double tx = opt_.symmetry_tol * lx, tq = opt_.load_symmetry_tol * lq;
   for (int i = 0; i < num_nodes_; ++i) {
     const int m = mirror_[i];
     const double ex = std::abs(x(0, m) - x(0, i)) + std::abs(x(1, m) - x(1, i)) + std::abs(x(2, m) + x(2, i));

@@ -27,7 +27,8 @@
 ///     target are close to it (h/2 for a mid-side node); their regular-rule contribution is replaced by a
 ///     subdivided rule (Options::near_subdivision, near_degree).
 ///  5. Mirror symmetry x3 → −x3: if positions and loads are symmetric (checked in O(N) with
-///     mesh.mirror_node, to a tolerance relative to the extent of x and the largest |q|), only the targets
+///     mesh.mirror_node, to tolerances relative to the extent of x and to the largest |q|: symmetry_tol and
+///     the looser load_symmetry_tol, see SingleLayerOptions), only the targets
 ///     with x3 ≥ 0 are evaluated and u is mirrored to the others (u3 flips sign). Otherwise every target is
 ///     evaluated. Options::symmetry forces either way.
 ///
@@ -99,7 +100,16 @@ struct SingleLayerOptions {
   int far_degree = 0;
   double far_radius = 4.0;     ///< far when |x0 − c_e| > far_radius · ρ_e; finite and > 1 (ignored when off)
   Symmetry symmetry = Symmetry::Auto;
-  double symmetry_tol = 1e-10; ///< relative tolerance of the symmetry check (≥ 0)
+  double symmetry_tol = 1e-10; ///< relative tolerance of the symmetry check on the positions (≥ 0)
+  /// Relative tolerance of the symmetry check on the load (≥ 0), |q_i − P q_mirror(i)| ≤ tol · max |q|. Looser
+  /// than the positions' on purpose: the load is a function of the positions (membrane law, bending, mass
+  /// solve), so on a symmetric surface its asymmetry is the round-off of those sums, and that grows with the
+  /// level and the bending stiffness — measured on a deformed a/b = 2 capsule, 1.8e-12 of max |q| on level 4
+  /// without bending, 1.1e-11 with κ_b = 1e-3 and 1.1e-10 with κ_b = 1e-2 (≈ × 9 per level), which under a
+  /// 1e-10 tolerance turned level-4 bending runs to the general evaluation (every target, twice the cost).
+  /// Evaluating a load asymmetric by δ symmetrically changes u by O(δ) |u|: 1e-8 is far below the kernel's
+  /// own error in mixed precision (3e-7) and any discretisation error, and leaves a margin of ≈ 10 for level 5.
+  double load_symmetry_tol = 1e-8;
   KernelChoice kernel = KernelChoice::Fast;
   KernelPrecision precision = KernelPrecision::Double;  ///< of the fast regular sum (see KernelPrecision)
   kernel::FastConfig fast{};   ///< tuning of the fast kernel (block 1..4)

@@ -126,6 +126,11 @@ class CaseRun {
       // resumed case reports what the uninterrupted one would (the campaigns' core-hours rest on it).
       evaluations_before_ = static_cast<long>(cp.scalars["flow_evaluations"]);
       wall_before_ = cp.scalars["wall_s"];
+      // The same for the phase times (absent before 2026-12-06: 0, so a case resumed from such a checkpoint
+      // reports the phases of its later invocations only, while wall_s covers all).
+      membrane_before_ = cp.scalars["membrane_s"];
+      load_before_ = cp.scalars["load_s"];
+      stokes_before_ = cp.scalars["stokes_s"];
       writer_.emplace(io::CaseWriter::resume(case_file_, case_attributes(config_), series_));
     } else {
       writer_.emplace(case_file_, case_attributes(config_));
@@ -282,9 +287,9 @@ class CaseRun {
     r_.steps = step_;
     r_.t_final = t_;
     r_.flow_evaluations = evaluations_before_ + flow_->timings().evaluations;
-    r_.membrane_s = flow_->timings().membrane_s + flow_->timings().bending_s;  // elastic + bending
-    r_.load_s = flow_->timings().load_s;
-    r_.stokes_s = flow_->timings().stokes_s;
+    r_.membrane_s = membrane_s();
+    r_.load_s = load_before_ + flow_->timings().load_s;
+    r_.stokes_s = stokes_before_ + flow_->timings().stokes_s;
     r_.case_file = case_file_;
   }
 
@@ -311,6 +316,9 @@ class CaseRun {
     cp.scalars["wrinkle_wavelength_of_max"] = wrinkle_max_.wrinkle_wavelength;
     cp.scalars["flow_evaluations"] = static_cast<double>(evaluations_before_ + flow_->timings().evaluations);
     cp.scalars["wall_s"] = wall_before_ + std::chrono::duration<double>(Clock::now() - wall0_).count();
+    cp.scalars["membrane_s"] = membrane_s();
+    cp.scalars["load_s"] = load_before_ + flow_->timings().load_s;
+    cp.scalars["stokes_s"] = stokes_before_ + flow_->timings().stokes_s;
     cp.strings["case"] = identity_;
     io::write_checkpoint(checkpoint_file_, cp);
   }
@@ -369,8 +377,13 @@ class CaseRun {
   Eigen::Matrix3Xd x_;
   double t_ = 0.0;
   long step_ = 0;
-  long evaluations_before_ = 0;  // flow evaluations and wall time of the invocations before a resume
+  long evaluations_before_ = 0;  // flow evaluations, wall and phase times of the invocations before a resume
   double wall_before_ = 0.0;
+  double membrane_before_ = 0.0, load_before_ = 0.0, stokes_before_ = 0.0;
+  // Membrane phase of all invocations: elastic + bending.
+  [[nodiscard]] double membrane_s() const {
+    return membrane_before_ + flow_->timings().membrane_s + flow_->timings().bending_s;
+  }
   diagnostics::TimeSeries series_;
   int p_node_ = 0;
   bool keep_mirror_ = false;  // the state started mirror-symmetric: keep it exactly so (restore_or_start)

@@ -307,12 +307,24 @@ TEST(CaseDriver, BendingRunIsStableRecordedAndResumesBitwise) {
   const auto rdir = scratch("bending_resumed");
   RunOptions o = quiet_in(rdir);
   o.stop_after_steps = full.steps / 2;
-  ASSERT_EQ(run_case(c, o).status, "interrupted");
+  const CaseResult first = run_case(c, o);
+  ASSERT_EQ(first.status, "interrupted");
+  // The checkpoint carries the phase times of the first invocation, so that the resumed case reports both.
+  const io::Checkpoint cp = io::read_checkpoint(rdir / io::kCheckpointFileName);
+  ASSERT_TRUE(cp.scalars.count("stokes_s") == 1 && cp.scalars.count("membrane_s") == 1);
+  // (At most what the invocation reports: its end-of-run diagnostics evaluate the membrane after the save.)
+  EXPECT_GT(cp.scalars.at("stokes_s"), 0.0);
+  EXPECT_LE(cp.scalars.at("stokes_s"), first.stokes_s);
+  EXPECT_GT(cp.scalars.at("membrane_s"), 0.0);
+  EXPECT_LE(cp.scalars.at("membrane_s"), first.membrane_s);
   o.stop_after_steps = 0;
   o.resume = true;
   const CaseResult resumed = run_case(c, o);
   EXPECT_EQ(resumed.steps, full.steps);
   EXPECT_EQ(resumed.flow_evaluations, full.flow_evaluations) << "the cost of both invocations";
+  // The phase times too (they were the second invocation's alone): the first invocation's and more.
+  EXPECT_GT(resumed.stokes_s, first.stokes_s) << "the phases of both invocations";
+  EXPECT_GT(resumed.membrane_s, first.membrane_s);
   EXPECT_TRUE(io::read_case_file(rdir / "case.h5").series == series);
 }
 

@@ -136,31 +136,9 @@ TEST(SingleLayer, SymmetryIsSkippedForAnAsymmetricScene) {
   EXPECT_EQ(sym.last_stats().targets, m.num_nodes());
   EXPECT_EQ((u1 - full.apply(x, q_odd)).cwiseAbs().maxCoeff(), 0.0);
 
-  // A small position perturbation of one node (1e-6 of the size) breaks it too; 1e-14 does not.
-  Matrix3Xd x_bad = x;
-  x_bad(0, 17) += 1e-6;
-  EXPECT_FALSE(sym.is_symmetric(x_bad, q));
-  x_bad(0, 17) = x(0, 17) + 1e-14;
-  EXPECT_TRUE(sym.is_symmetric(x_bad, q));
-
-  // Forcing it on an asymmetric scene is an error.
-  SingleLayerOptions on;
-  on.symmetry = Symmetry::On;
-  SingleLayer forced(m, on);
-  EXPECT_THROW(forced.apply(x, q_odd), std::invalid_argument);
-}
-
-// A load whose asymmetry is round-off of the membrane and bending sums (measured up to 1.1e-10 of max |q| on level
-// 4 with κ_b = 1e-2, SingleLayerOptions::load_symmetry_tol) keeps the symmetric evaluation, and its u stays that
-// close to the full evaluation's; an asymmetry of 1e-6 does not (a load that is not a function of symmetric
-// positions). Under the positions' tolerance (1e-10) the first case fell back to every target.
-TEST(SingleLayer, RoundOffAsymmetryOfTheLoadKeepsTheSymmetricEvaluation) {
-  const auto m = mesh::make_capsule_mesh(2, 2.0);
-  Matrix3Xd x, q;
-  symmetric_scene(m, x, q);
-  SingleLayerOptions off;
-  off.symmetry = Symmetry::Off;
-  SingleLayer full(m, off), sym(m);
+  // A load asymmetry of round-off size keeps it (SingleLayerOptions::load_symmetry_tol: the membrane and bending
+  // sums leave up to 1.1e-10 of max |q| on level 4 with κ_b = 1e-2, which the positions' tolerance of 1e-10 sent
+  // to every target), and u stays that close to the full evaluation's; 1e-6 of max |q| does not.
   const double lq = q.colwise().norm().maxCoeff();
   int node = -1;
   for (int i = 0; i < m.num_nodes() && node < 0; ++i)
@@ -181,6 +159,19 @@ TEST(SingleLayer, RoundOffAsymmetryOfTheLoadKeepsTheSymmetricEvaluation) {
       EXPECT_EQ(diff, 0.0);
     }
   }
+
+  // A small position perturbation of one node (1e-6 of the size) breaks it too; 1e-14 does not.
+  Matrix3Xd x_bad = x;
+  x_bad(0, 17) += 1e-6;
+  EXPECT_FALSE(sym.is_symmetric(x_bad, q));
+  x_bad(0, 17) = x(0, 17) + 1e-14;
+  EXPECT_TRUE(sym.is_symmetric(x_bad, q));
+
+  // Forcing it on an asymmetric scene is an error.
+  SingleLayerOptions on;
+  on.symmetry = Symmetry::On;
+  SingleLayer forced(m, on);
+  EXPECT_THROW(forced.apply(x, q_odd), std::invalid_argument);
 }
 
 TEST(SingleLayer, FastAndPlainKernelsAgree) {

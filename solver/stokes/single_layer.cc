@@ -21,10 +21,11 @@ bool fail(std::string* why, const std::string& message) {
 }
 
 // The Duffy integral of one element with the target at the apex of the table, in single precision
-// (KernelPrecision::Mixed), added to acc. C and D: the element's position (only C1..C5 are read: the apex is
-// the target, so the re-expanded constant term is 0) and its load in monomial form about (ξ, η) = (0, 0)
-// (mesh::p2_monomials), re-expanded here in double about the apex P, so
-// that the float loop works with coordinates (u, v) relative to P and a position d that vanishes at P exactly:
+// (KernelPrecision::Mixed), added to acc. C and D: the element's position and load in monomial form about
+// (ξ, η) = (0, 0) (mesh::p2_monomials), re-expanded here in double about the apex P. Of the position only
+// C1..C5 are read: about P, which is the target, the constant term is 0, and the others do not depend on the
+// origin of the positions (absolute ones do: their rounding, 1e-16 of |x|, is far below float's). So the
+// float loop works with coordinates (u, v) relative to P and a position d that vanishes at P exactly:
 // next to the apex, where the points crowd and the terms are largest, d keeps its float relative accuracy
 // instead of inheriting the cancellation of C0 + ... against a far origin. The terms are summed in float over
 // chunks of kDuffyChunk points (one 8 × 8 Duffy square) and the chunk sums in double, as kernel::sum_mixed

@@ -288,8 +288,8 @@ class CaseRun {
     r_.t_final = t_;
     r_.flow_evaluations = evaluations_before_ + flow_->timings().evaluations;
     r_.membrane_s = membrane_s();
-    r_.load_s = load_before_ + flow_->timings().load_s;
-    r_.stokes_s = stokes_before_ + flow_->timings().stokes_s;
+    r_.load_s = load_s();
+    r_.stokes_s = stokes_s();
     r_.case_file = case_file_;
   }
 
@@ -317,8 +317,8 @@ class CaseRun {
     cp.scalars["flow_evaluations"] = static_cast<double>(evaluations_before_ + flow_->timings().evaluations);
     cp.scalars["wall_s"] = wall_before_ + std::chrono::duration<double>(Clock::now() - wall0_).count();
     cp.scalars["membrane_s"] = membrane_s();
-    cp.scalars["load_s"] = load_before_ + flow_->timings().load_s;
-    cp.scalars["stokes_s"] = stokes_before_ + flow_->timings().stokes_s;
+    cp.scalars["load_s"] = load_s();
+    cp.scalars["stokes_s"] = stokes_s();
     cp.strings["case"] = identity_;
     io::write_checkpoint(checkpoint_file_, cp);
   }
@@ -380,10 +380,12 @@ class CaseRun {
   long evaluations_before_ = 0;  // flow evaluations, wall and phase times of the invocations before a resume
   double wall_before_ = 0.0;
   double membrane_before_ = 0.0, load_before_ = 0.0, stokes_before_ = 0.0;
-  // Membrane phase of all invocations: elastic + bending.
+  // The phase times of all invocations (membrane: elastic + bending), for the result and the checkpoint.
   [[nodiscard]] double membrane_s() const {
     return membrane_before_ + flow_->timings().membrane_s + flow_->timings().bending_s;
   }
+  [[nodiscard]] double load_s() const { return load_before_ + flow_->timings().load_s; }
+  [[nodiscard]] double stokes_s() const { return stokes_before_ + flow_->timings().stokes_s; }
   diagnostics::TimeSeries series_;
   int p_node_ = 0;
   bool keep_mirror_ = false;  // the state started mirror-symmetric: keep it exactly so (restore_or_start)

@@ -117,7 +117,7 @@ SingleLayer::SingleLayer(const mesh::SurfaceMesh& mesh, const SingleLayerOptions
   regular_.assign(regular.points().begin(), regular.points().end());
   rule_size_ = static_cast<int>(regular_.size());
   for (int l = 0; l < 6; ++l) duffy_[l] = make_point_table(duffy_rule(l, opt_.duffy_order));
-  if (uses_mixed_corrections())
+  if (uses_mixed_precision())
     for (int l = 0; l < 6; ++l) duffy_f_[l] = make_apex_table(l, opt_.duffy_order);
   if (opt_.near_subdivision > 0) {
     near_rule_ = replace_rule(subdivided_rule(opt_.near_subdivision, opt_.near_degree), regular_);
@@ -248,7 +248,7 @@ void SingleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Ma
   const SourceArrays& reg = *regular_points_;
   const int stride = regular_stride_;
   const int* slot = regular_slot_;
-  const bool mixed = uses_mixed_corrections();
+  const bool mixed = uses_mixed_precision();
   if (mixed) {
     // The monomials of every element's position and load, once per call instead of once per (target,
     // element) pair: in duffy_mixed only C1..C5 of the position enter (the apex is the target), and those do
@@ -360,7 +360,7 @@ void SingleLayer::mirror(Eigen::Matrix3Xd& u) const {
   // moves such nodes off the plane by more than symmetry_tol within a few steps, and every later evaluation
   // loses the symmetry (twice the targets: measured 1.06× instead of 1.7× on a level-3 case). The symmetry
   // says u3 = 0 there exactly; in double the same u3 is round-off and left as it is (bit for bit unchanged).
-  const bool on_plane_zero = opt_.precision == KernelPrecision::Mixed && opt_.kernel == KernelChoice::Fast;
+  const bool on_plane_zero = uses_mixed_precision();
   for (const int i : target_ids_) {
     const int m = mirror_[i];
     if (m == i) {

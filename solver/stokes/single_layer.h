@@ -172,8 +172,9 @@ class SingleLayer {
   void singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q);
   void near_correction(Eigen::Matrix3Xd& u);
   void mirror(Eigen::Matrix3Xd& u) const;
-  // Whether the Duffy terms are summed in float (KernelPrecision::Mixed with the fast kernel).
-  [[nodiscard]] bool uses_mixed_corrections() const {
+  // Whether float pair terms are in use (KernelPrecision::Mixed with the fast kernel): the regular sum and the
+  // Duffy terms in float, u3 = 0 set on the mirror plane.
+  [[nodiscard]] bool uses_mixed_precision() const {
     return opt_.precision == KernelPrecision::Mixed && opt_.kernel == KernelChoice::Fast;
   }
 

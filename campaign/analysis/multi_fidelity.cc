@@ -23,37 +23,79 @@ const SampleGroup* find_group(const std::vector<SampleGroup>& groups, const std:
   return nullptr;
 }
 
-// Collects new capillary numbers for one target group: positive, not among `existing`, not twice.
+// Which answer a proposed case is for: what its periodic stop has to wait for with stop_for_answer (a bit
+// set: a Ca that serves both answers waits for both).
+enum Need : unsigned { kMinD12 = 1, kMaxTauMin = 2, kBoth = 3 };
+
+// Collects new capillary numbers for one target group: positive, not among `existing`, not twice (a Ca
+// proposed for both answers is proposed once, for both).
 struct Proposals {
   const std::vector<double>& existing;
   std::vector<double> ca;
-  void add(std::optional<double> x) {
+  std::vector<unsigned> need;  // aligned with ca
+  void add(std::optional<double> x, unsigned for_answer) {
     if (!x || !(*x > 0)) return;
     auto same = [&](double y) { return same_ca(y, *x); };
-    if (std::any_of(existing.begin(), existing.end(), same) || std::any_of(ca.begin(), ca.end(), same)) return;
+    if (std::any_of(existing.begin(), existing.end(), same)) return;
+    if (const auto it = std::find_if(ca.begin(), ca.end(), same); it != ca.end()) {
+      need[static_cast<std::size_t>(it - ca.begin())] |= for_answer;
+      return;
+    }
     ca.push_back(*x);
+    need.push_back(for_answer);
   }
 };
 
-// Appends the cases of `ca` (template `base`, at `level`) within the budget; false once it is spent.
+// time.stop_test of a new case for answer(s) `need` with stop_for_answer; without it the template's.
+void set_stop_test(CaseParams& p, bool stop_for_answer, unsigned need) {
+  if (!stop_for_answer) return;
+  if (need == kMinD12) p.set("time.stop_test", std::string("min_D12"));
+  else if (need == kMaxTauMin) p.set("time.stop_test", std::string("max_tau_min"));
+  else p.erase("time.stop_test");  // the default, "both": the identity of a case that never had the key
+}
+
+// Appends the cases of `proposals` (template `base`, at `level`) within the budget; false once it is spent.
 // `precision`: numerics.kernel_precision of the new cases ("": the base case's).
-bool emit(const CaseParams& base, int level, const std::vector<double>& ca, std::vector<CaseParams>& out, int& budget,
-          const std::string& precision = "") {
-  for (double x : ca) {
+bool emit(const CaseParams& base, int level, const Proposals& proposals, const MultiFidelityOptions& o,
+          std::vector<CaseParams>& out, int& budget, const std::string& precision = "") {
+  for (std::size_t i = 0; i < proposals.ca.size(); ++i) {
     if (budget <= 0) return false;
     CaseParams p = base;
     p.set("mesh.level", std::int64_t{level});
-    p.set("flow.capillary_number", x);
+    p.set("flow.capillary_number", proposals.ca[i]);
     if (!precision.empty()) p.set("numerics.kernel_precision", precision);
+    set_stop_test(p, o.stop_for_answer, proposals.need[i]);
     out.push_back(std::move(p));
     --budget;
   }
   return true;
 }
 
-// The samples an answer rests on: both sides of each Ca* edge and of the CaH bracket.
-std::vector<std::optional<double>> bracketing_ca(const Transition& t) {
-  return {t.ca_star_below, t.ca_star_low, t.ca_star_high, t.ca_star_above, t.ca_h_low, t.ca_h_high};
+// The samples an answer rests on: both sides of each Ca* edge (min D12) and of the CaH bracket (max τmin).
+void add_bracketing_ca(const Transition& t, Proposals& p) {
+  for (const auto& x : {t.ca_star_below, t.ca_star_low, t.ca_star_high, t.ca_star_above}) p.add(x, kMinD12);
+  for (const auto& x : {t.ca_h_low, t.ca_h_high}) p.add(x, kMaxTauMin);
+}
+
+// What a refinement proposal @p x of a group with transition @p t and samples @p samples is for (the brackets
+// propose_refinement bisects): a Ca* edge's bracket, or without a band the neighbourhood of the smallest min
+// D12, needs min D12; the CaH bracket max τmin; both where they overlap (or, defensively, neither).
+unsigned need_inside(const Transition& t, const std::vector<Sample>& samples, double x) {
+  auto inside = [x](const std::optional<double>& a, const std::optional<double>& b) {
+    return a && b && x > std::min(*a, *b) && x < std::max(*a, *b);
+  };
+  unsigned need = 0;
+  if (inside(t.ca_star_below, t.ca_star_low) || inside(t.ca_star_high, t.ca_star_above)) need |= kMinD12;
+  if (!t.ca_star_low && t.ca_min_d12) {
+    std::optional<double> left, right;  // the samples next to the minimum
+    for (const auto& s : samples) {
+      if (s.ca < *t.ca_min_d12 && (!left || s.ca > *left)) left = s.ca;
+      if (s.ca > *t.ca_min_d12 && (!right || s.ca < *right)) right = s.ca;
+    }
+    if (inside(left, t.ca_min_d12) || inside(t.ca_min_d12, right)) need |= kMinD12;
+  }
+  if (inside(t.ca_h_low, t.ca_h_high)) need |= kMaxTauMin;
+  return need ? need : kBoth;
 }
 
 // Whether a group's smallest min D12 lies near enough the threshold (< 3×) that a band may hide between its
@@ -115,14 +157,14 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
     const SampleGroup& scan = groups[i];
     std::size_t ia = 0;
     const SampleGroup* answer = find_group(groups, roles, scan, answer_level, "answer", &ia);
-    Proposals p{answer ? answer->case_ca : kNone, {}};
+    Proposals p{answer ? answer->case_ca : kNone, {}, {}};
 
     // Seed: the scan's brackets.
     const Transition ts = analyse_group(scan.key, scan.samples, o.d12_threshold);
-    for (const auto& x : bracketing_ca(ts)) p.add(x);
-    p.add(smallest_if_all_compressed(scan.samples));  // a spheroid's ca_h_high; a sphere has no such bound
+    add_bracketing_ca(ts, p);
+    p.add(smallest_if_all_compressed(scan.samples), kMaxTauMin);  // a spheroid's ca_h_high; a sphere has none
     if (!ts.ca_star_low && ts.ca_min_d12) {
-      p.add(ts.ca_min_d12);
+      p.add(ts.ca_min_d12, kMinD12);
       // No band on the scan level, but a minimum near the threshold (< 3×, as the refinement's bracketing):
       // the band can lie between the minimum's scan neighbours (the oblate capsule with κ_b = 1e-3: 0.072 at
       // Ca 0.08 and 0.074 at 0.1 on level 2, a band ≈ 0.01 wide between them), so they seed the answer level
@@ -133,8 +175,8 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
       for (const auto& s : scan.samples)
         if (s.min_d12 && same_ca(s.ca, *ts.ca_min_d12)) best = *s.min_d12;
       if (it != ca.end() && minimum_near_threshold(best, o.d12_threshold) && !is_sphere(ts)) {
-        if (it != ca.begin()) p.add(*std::prev(it));
-        if (std::next(it) != ca.end()) p.add(*std::next(it));
+        if (it != ca.begin()) p.add(*std::prev(it), kMinD12);
+        if (std::next(it) != ca.end()) p.add(*std::next(it), kMinD12);
       }
     }
 
@@ -153,7 +195,7 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
           if (*it < x && !same_ca(*it, x)) return *it;
         return beyond ? std::optional<double>(quantise_ca(x / 1.5, o.ca_tolerance)) : std::nullopt;
       };
-      if (ta.ca_h_low && !ta.ca_h_high) p.add(above(*ta.ca_h_low, true));
+      if (ta.ca_h_low && !ta.ca_h_high) p.add(above(*ta.ca_h_low, true), kMaxTauMin);
       if (const auto smallest_compressed = smallest_if_all_compressed(answer->samples)) {
         // max τmin < 0 at every answer-level sample is ambiguous: a membrane is compressed both above CaH
         // and below a lower critical number CaL (Lac et al. 2004; the NH sphere on level 3: τ < 0 at 0.4,
@@ -165,14 +207,14 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
         // nothing). Past that step the answer is "max τmin < 0 at every sampled Ca".
         const double smallest = *smallest_compressed;
         if (!scan_ca.empty() && (smallest > scan_ca.front() || same_ca(smallest, scan_ca.front())))
-          p.add(below(smallest, true));  // the next scan Ca below, or one step below the scan's range
+          p.add(below(smallest, true), kMaxTauMin);  // the next scan Ca below, or one step below the scan's range
         double largest = smallest;
         for (const auto& s : answer->samples)
           if (s.max_tau_min) largest = std::max(largest, s.ca);
-        p.add(above(largest, false));
+        p.add(above(largest, false), kMaxTauMin);
       }
-      if (ta.ca_star_low && !ta.ca_star_below) p.add(below(*ta.ca_star_low, false));
-      if (ta.ca_star_high && !ta.ca_star_above) p.add(above(*ta.ca_star_high, false));
+      if (ta.ca_star_low && !ta.ca_star_below) p.add(below(*ta.ca_star_low, false), kMinD12);
+      if (ta.ca_star_high && !ta.ca_star_above) p.add(above(*ta.ca_star_high, false), kMinD12);
       // Refine: bisect, each bracket down to max(ca_tolerance, its numerical error) — with dt_check, once the
       // cell's dt check exists (where phase 5 has a case to re-run), so that the error has its dt part.
       const bool dt_pending = o.dt_check && !has_dt_check(groups, roles, *answer) && dt_check_sample(ta, *answer);
@@ -184,10 +226,11 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
           if (s.min_d12) best = std::min(best, *s.min_d12);
         const BracketTolerances tol{e.ca_star_low.numerical.value_or(0), e.ca_star_high.numerical.value_or(0),
                                     e.ca_h.numerical.value_or(0), minimum_near_threshold(best, o.d12_threshold)};
-        for (double x : propose_refinement(ta, answer->samples, o.ca_tolerance, tol, answer->case_ca)) p.add(x);
+        for (double x : propose_refinement(ta, answer->samples, o.ca_tolerance, tol, answer->case_ca))
+          p.add(x, need_inside(ta, answer->samples, x));
       }
     }
-    if (!emit(answer ? answer->base : scan.base, answer_level, p.ca, out, budget)) break;
+    if (!emit(answer ? answer->base : scan.base, answer_level, p, o, out, budget)) break;
   }
   return out;
 }
@@ -212,9 +255,9 @@ std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups
     if (roles[i] != "answer" || groups[i].key.mesh_level != o.levels[1]) continue;
     const SampleGroup& answer = groups[i];
     const SampleGroup* check = find_group(groups, roles, answer, o.levels[2], "mesh_check");
-    Proposals p{check ? check->case_ca : kNone, {}};
+    Proposals p{check ? check->case_ca : kNone, {}, {}};
     const Transition t = analyse_group(answer.key, answer.samples, o.d12_threshold);
-    for (const auto& x : bracketing_ca(t)) p.add(x);
+    add_bracketing_ca(t, p);
     if (check) {
       // Where the check level's values at a bracket lie on one side of the target (its answer is outside the
       // bracket), the answer level's next sample outwards, one at a time, until the check level brackets it
@@ -237,7 +280,7 @@ std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups
           for (const auto& s : check->samples) valued |= same_ca(s.ca, x) && (of_ca_h ? s.max_tau_min : s.min_d12);
           if (valued) continue;
           // The next one to run; a check case there without a value yet (queued, running): wait for it.
-          if (std::none_of(check->case_ca.begin(), check->case_ca.end(), same)) p.add(x);
+          if (std::none_of(check->case_ca.begin(), check->case_ca.end(), same)) p.add(x, of_ca_h ? kMaxTauMin : kMinD12);
           return;
         }
       };
@@ -245,7 +288,7 @@ std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups
       outwards(false, t.ca_star_below, t.ca_star_low);
       outwards(false, t.ca_star_high, t.ca_star_above);
     }
-    if (!emit(answer.base, o.levels[2], p.ca, out, budget, o.check_precision)) break;
+    if (!emit(answer.base, o.levels[2], p, o, out, budget, o.check_precision)) break;
   }
   return out;
 }
@@ -269,6 +312,9 @@ std::vector<CaseParams> dt_check_cases(const std::vector<SampleGroup>& groups, c
     CaseParams p = answer.base;
     p.set("flow.capillary_number", c->ca);
     p.set("time.dt", 0.5 * *c->dt);
+    // The same stop as the case it halves the step of: the pair then differs by the step, not by what it waited for.
+    set_stop_test(p, o.stop_for_answer,
+                  c->stop_test == "min_D12" ? kMinD12 : c->stop_test == "max_tau_min" ? kMaxTauMin : kBoth);
     out.push_back(std::move(p));
     --budget;
   }

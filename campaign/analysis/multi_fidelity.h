@@ -48,6 +48,10 @@ struct MultiFidelityOptions {
   bool adaptive = false;        ///< phase 4
   bool dt_check = false;        ///< phase 5 will run: phase 4 waits for each cell's dt check
   std::string check_precision;  ///< numerics.kernel_precision of phase 6's new cases ("": the answer case's)
+  /// @brief Phases 2–6 give each new case the stop test of the answer it is for (time.stop_test): a Ca* edge's
+  /// cases stop once min D12 repeats, CaH's once max τmin repeats, a Ca serving both waits for both; the scan
+  /// level (the grid) keeps the template's. Off: every new case keeps its template's stop test.
+  bool stop_for_answer = false;
 };
 
 /// @brief Phases 2–4: the cases of one round on the answer level (none: the answer level is done). New cases

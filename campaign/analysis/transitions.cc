@@ -116,7 +116,9 @@ std::string group_key(const CaseParams& params) {
     const std::string k = line.substr(0, eq), v = line.substr(eq + 1);
     // Ca varies within a group; the kernel precision is how a case was computed, not what (both precisions
     // of a case answer the same question to ~1e-6): a check level run in mixed precision joins its group.
-    if (k == "flow.capillary_number" || k == "numerics.kernel_precision") continue;
+    // Likewise the stop test: which answer the periodic stop waited for (a multi-fidelity campaign's
+    // stop_for_answer), not the question; the answer it did not wait for carries its period spread.
+    if (k == "flow.capillary_number" || k == "numerics.kernel_precision" || k == "time.stop_test") continue;
     auto parsed = nlohmann::json::parse(v, nullptr, false);
     j[k] = (!parsed.is_discarded() && (parsed.is_number() || parsed.is_boolean() || parsed.is_string()))
                ? parsed
@@ -140,7 +142,7 @@ std::string group_difference(const std::string& a, const std::string& b) {
 
 std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases) {
   std::map<std::string, std::size_t> index;
-  std::vector<std::vector<bool>> sample_is_double;  // per group, aligned with its samples
+  std::vector<std::vector<int>> sample_rank;  // per group, aligned with its samples (preference, see below)
   std::vector<SampleGroup> out;
   for (const auto& c : cases) {
     const std::string key = group_key(c.params);
@@ -154,26 +156,31 @@ std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases) {
       g.key.mesh_level = c.params.mesh_level();
       g.base = c.params;
       out.push_back(std::move(g));
-      sample_is_double.emplace_back();
+      sample_rank.emplace_back();
     }
     SampleGroup& g = out[it->second];
     const double ca = c.params.capillary_number();
     g.case_ca.push_back(ca);
     if (c.status != "done") continue;
-    const Sample sample{ca, c.min_d12, c.max_tau_min, c.case_id, c.min_d12_spread, c.max_tau_min_spread, c.dt};
-    // One sample per Ca: where a Ca was run in both precisions, the double one (the reference) is used.
     const auto& values = c.params.values();
-    const auto precision = values.find("numerics.kernel_precision");
-    const std::string* text = precision == values.end() ? nullptr : std::get_if<std::string>(&precision->second);
-    const bool is_double = !text || *text == "double";
-    auto& doubles = sample_is_double[it->second];
+    auto text = [&](const char* key, const char* unset) {
+      const auto v = values.find(key);
+      const std::string* t = v == values.end() ? nullptr : std::get_if<std::string>(&v->second);
+      return t ? *t : std::string(unset);
+    };
+    const std::string stop_test = text("time.stop_test", "both");
+    const Sample sample{ca, c.min_d12, c.max_tau_min, c.case_id, c.min_d12_spread, c.max_tau_min_spread, c.dt, stop_test};
+    // One sample per Ca: where a Ca was run in both precisions, the double one (the reference); then the one
+    // whose stop waited for both answers.
+    const int rank = 2 * (text("numerics.kernel_precision", "double") == "double") + (stop_test == "both");
+    auto& ranks = sample_rank[it->second];
     const auto same = std::find_if(g.samples.begin(), g.samples.end(), [&](const Sample& s) { return same_ca(s.ca, ca); });
     if (same == g.samples.end()) {
       g.samples.push_back(sample);
-      doubles.push_back(is_double);
-    } else if (const auto k = static_cast<std::size_t>(same - g.samples.begin()); is_double && !doubles[k]) {
+      ranks.push_back(rank);
+    } else if (const auto k = static_cast<std::size_t>(same - g.samples.begin()); rank > ranks[k]) {
       *same = sample;
-      doubles[k] = true;
+      ranks[k] = rank;
     }
   }
   return out;

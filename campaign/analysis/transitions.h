@@ -74,6 +74,7 @@ struct Sample {
   std::optional<double> min_d12_spread;      ///< min_D12_period_spread of its result (nullopt: not recorded)
   std::optional<double> max_tau_min_spread;  ///< max_tau_min_period_spread of its result
   std::optional<double> dt;                  ///< time step the case ran with
+  std::string stop_test = "both";            ///< its time.stop_test (which answers its stop waited for)
 };
 
 /// @brief One case of a campaign with its result, as the store reads it (the input of the grouping).
@@ -94,8 +95,9 @@ struct SampleGroup {
   CaseParams base;                      ///< one case of the group: the template of new cases
 };
 
-/// @brief The group key of a case: canonical JSON of its identity keys except Ca and numerics.kernel_precision
-/// (how a case was computed, not what: both precisions agree to ~1e-6 in min D12, results/speed/mixed_ab_case.json).
+/// @brief The group key of a case: canonical JSON of its identity keys except Ca, numerics.kernel_precision
+/// (how a case was computed, not what: both precisions agree to ~1e-6 in min D12, results/speed/mixed_ab_case.json)
+/// and time.stop_test (which answer its stop waited for; the other carries its period spread).
 std::string group_key(const CaseParams& params);
 
 /// @brief The keys in which two group keys differ, as "key (a vs b), ..." (for messages); "" if equal or
@@ -103,8 +105,9 @@ std::string group_key(const CaseParams& params);
 std::string group_difference(const std::string& group_key_a, const std::string& group_key_b);
 
 /// @brief Groups cases by group_key (groups in order of first appearance); a group with no done case is
-/// still listed (empty samples). Cases that differ in numerics.kernel_precision only share a group (see
-/// group_key); a Ca done in both precisions gives one sample, the double one. @throws
+/// still listed (empty samples). Cases that differ in numerics.kernel_precision or time.stop_test only share
+/// a group (see group_key); a Ca done more than once gives one sample: the double one, then the one whose
+/// stop test was "both". @throws
 /// capsim::config::ConfigError for a case the solver rejects.
 std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases);
 

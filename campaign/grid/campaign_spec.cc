@@ -205,7 +205,7 @@ CampaignSpec parse_campaign(const std::string& text, const std::string& source) 
     if (!a->is_table()) fail(source, "[analysis]", "expected a table");
     const auto& at = *a->as_table();
     expect_only(at, {"D12_threshold", "adaptive", "ca_tolerance", "max_cases", "max_rounds", "levels", "dt_check",
-                     "check_precision"},
+                     "check_precision", "stop_for_answer"},
                 source, "[analysis]");
     auto number = [&](const char* k, double& out, double lo, double hi) {
       if (auto* n = at.get(k)) {
@@ -267,6 +267,14 @@ CampaignSpec parse_campaign(const std::string& text, const std::string& source) 
         fail(source, "[analysis] dt_check", "needs [analysis] levels (it re-runs a case of the answer level)");
       spec.analysis.dt_check = *b;
     }
+    if (auto* n = at.get("stop_for_answer")) {
+      auto b = n->value_exact<bool>();
+      if (!b) fail(source, "[analysis] stop_for_answer", "expected true or false, got " + toml_type_name(*n));
+      if (*b && spec.analysis.levels.empty())
+        fail(source, "[analysis] stop_for_answer",
+             "needs [analysis] levels (it sets the stop test of the cases the answer level adds)");
+      spec.analysis.stop_for_answer = *b;
+    }
     if (auto* n = at.get("check_precision")) {
       auto v = n->value_exact<std::string>();
       if (!v) fail(source, "[analysis] check_precision", "expected a string, got " + toml_type_name(*n));
@@ -313,6 +321,7 @@ std::string CampaignSpec::to_json() const {
     j["analysis"]["dt_check"] = analysis.dt_check;
   }
   if (!analysis.check_precision.empty()) j["analysis"]["check_precision"] = analysis.check_precision;
+  if (analysis.stop_for_answer) j["analysis"]["stop_for_answer"] = true;
   return j.dump();
 }
 

@@ -38,6 +38,10 @@ struct AnalysisSpec {
   /// ~1e-6 in its answers, far below the level 3 → 4 differences it measures. A case's precision says how it
   /// was computed, not what: the analysis puts both precisions of a group into one (transitions.h group_key).
   std::string check_precision;
+  /// @brief Each case the answer and check levels add stops on the answer it is for (time.stop_test: min D12
+  /// for a Ca* edge, max τmin for CaH, both where a Ca serves both; analysis/multi_fidelity.h). Off by default:
+  /// with it the added cases have other identities, so a committed campaign would run its answer level again.
+  bool stop_for_answer = false;
 };
 
 /// @brief A validated campaign.

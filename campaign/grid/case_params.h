@@ -24,6 +24,8 @@ class CaseParams {
 
   /// @brief Sets one key (the caller has validated type and range).
   void set(const std::string& key, Value v) { values_[key] = std::move(v); }
+  /// @brief Removes one key (back to its default; a kStoredWhenSet key then leaves params_json as if never set).
+  void erase(const std::string& key) { values_.erase(key); }
   /// @brief All values, sorted by key.
   const std::map<std::string, Value>& values() const { return values_; }
 

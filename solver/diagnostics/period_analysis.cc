@@ -5,6 +5,7 @@
 #include <numbers>
 #include <optional>
 #include <stdexcept>
+#include <string>
 
 namespace capsim::diagnostics {
 namespace {
@@ -286,6 +287,23 @@ PeriodAnalysis analyse_periods(std::span<const double> t, std::span<const double
 
 PeriodAnalysis analyse_periods(const TimeSeries& series, const PeriodOptions& options) {
   return analyse_periods(series.t, series.D12, series.theta, series.tau_min, options);
+}
+
+ConvergenceOptions stop_test_options(std::string_view stop_test, double tolerance) {
+  constexpr double kUntested = std::numeric_limits<double>::infinity();
+  ConvergenceOptions o;
+  if (stop_test == "both") {
+    o.tol_D12 = o.tol_tau_min = tolerance;
+  } else if (stop_test == "min_D12") {
+    o.tol_D12 = tolerance;
+    o.tol_tau_min = kUntested;
+  } else if (stop_test == "max_tau_min") {
+    o.tol_D12 = kUntested;
+    o.tol_tau_min = tolerance;
+  } else {
+    throw std::invalid_argument("time.stop_test: unknown stop test '" + std::string(stop_test) + "'");
+  }
+  return o;
 }
 
 bool periodic_regime_converged(const PeriodAnalysis& analysis, const ConvergenceOptions& options) {

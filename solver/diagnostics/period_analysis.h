@@ -43,6 +43,12 @@ struct ConvergenceOptions {
   int periods = 2;            ///< number of successive periods that must agree pairwise (≥ 2)
 };
 
+/// @brief The stop test of a case: @p tolerance on the answers @p stop_test names (time.stop_test: "both",
+/// "min_D12" or "max_tau_min"); the other one gets an infinite tolerance, i.e. is not compared (a Table 1
+/// answer needs only one of them: a Ca* edge min D12, CaH max τmin). The period is compared in every case.
+/// @throws std::invalid_argument for another name (the key registry admits none).
+ConvergenceOptions stop_test_options(std::string_view stop_test, double tolerance);
+
 /// @brief Tunables of analyse_periods.
 struct PeriodOptions {
   /// A minimum of D12 is significant when D12 rises by at least max(min_prominence,

@@ -149,7 +149,7 @@ class CaseRun {
     next_snapshot_ = at_or_after(config_.snapshot_interval);
     next_sample_ = config_.sample_interval > 0 ? at_or_after(config_.sample_interval) : t_;
     next_wrinkle_ = after(kWrinkleInterval);
-    convergence_.tol_D12 = convergence_.tol_tau_min = config_.period_tolerance;
+    convergence_ = diagnostics::stop_test_options(config_.stop_test, config_.period_tolerance);
   }
 
   // --- March in time until an interrupt, t_end, a blow-up or a converged periodic regime.

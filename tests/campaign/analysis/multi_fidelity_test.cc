@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <string>
 #include <variant>
 
@@ -326,6 +327,96 @@ TEST(MultiFidelity, TheDtCheckHalvesTheStepOfTheCaHLowCase) {
   EXPECT_TRUE(dt_check_cases(group_cases(cases), kOptions, 100).empty()) << "it exists";
   // The dt_check case does not disturb the answer level's rounds (it is another group).
   EXPECT_TRUE(answer_level_round(group_cases(cases), MultiFidelityOptions{{2, 3}, 0.05, 0.005, false, false, ""}, 100).empty());
+}
+
+// time.stop_test of a new case: "(unset)" where the key is absent (the default "both", written nowhere, so the
+// identity is that of a case from before the key).
+std::string stop_of(const CaseParams& p) {
+  const auto it = p.values().find("time.stop_test");
+  return it == p.values().end() ? "(unset)" : std::get<std::string>(it->second);
+}
+
+std::map<double, std::string> stops_by_ca(const std::vector<CaseParams>& cases) {
+  std::map<double, std::string> out;
+  for (const auto& p : cases) out[p.capillary_number()] = stop_of(p);
+  return out;
+}
+
+// [analysis] stop_for_answer: each case the answer and check levels add stops on the answer it is for. A Ca*
+// band at [0.03, 0.05] and CaH in (0.2, 0.5) on the scan level.
+TEST(MultiFidelity, StopForAnswerGivesEachNewCaseTheStopTestOfItsAnswer) {
+  const auto d12 = [](double ca) { return ca >= 0.029 && ca <= 0.051 ? 0.03 : 0.2; };
+  const auto tau = [](double ca) { return 0.3 - ca; };
+  std::vector<CaseSample> cases;
+  for (double ca : {0.01, 0.02, 0.03, 0.05, 0.06, 0.2, 0.5, 1.0}) cases.push_back(fake(2, ca, tau, "done", 0, d12));
+  MultiFidelityOptions o = kOptions;
+  using Stops = std::map<double, std::string>;
+  EXPECT_EQ(stops_by_ca(answer_level_round(group_cases(cases), o, 100)),
+            (Stops{{0.02, "(unset)"}, {0.03, "(unset)"}, {0.05, "(unset)"}, {0.06, "(unset)"}, {0.2, "(unset)"},
+                   {0.5, "(unset)"}}))
+      << "off: every case keeps its template's stop";
+  o.stop_for_answer = true;
+  EXPECT_EQ(stops_by_ca(answer_level_round(group_cases(cases), o, 100)),
+            (Stops{{0.02, "min_D12"}, {0.03, "min_D12"}, {0.05, "min_D12"}, {0.06, "min_D12"}, {0.2, "max_tau_min"},
+                   {0.5, "max_tau_min"}}));
+  // A Ca that brackets both answers waits for both (CaH in (0.03, 0.05) here).
+  std::vector<CaseSample> overlap;
+  for (double ca : {0.01, 0.02, 0.03, 0.05, 0.06}) overlap.push_back(fake(2, ca, [](double c) { return 0.04 - c; },
+                                                                             "done", 0, d12));
+  EXPECT_EQ(stops_by_ca(answer_level_round(group_cases(overlap), o, 100)),
+            (Stops{{0.02, "min_D12"}, {0.03, "(unset)"}, {0.05, "(unset)"}, {0.06, "min_D12"}}));
+
+  // The answer level has the seeds (level 3 = level 2: no mesh error): the refinement's bisections get the
+  // stop of the bracket they halve, whatever the stop of the cases that made it.
+  auto with_stop = [](CaseSample c, const std::string& stop) {
+    c.params.set("time.stop_test", stop);
+    return c;
+  };
+  for (double ca : {0.02, 0.03, 0.05, 0.06}) cases.push_back(with_stop(fake(3, ca, tau, "done", 0, d12), "min_D12"));
+  for (double ca : {0.2, 0.5}) cases.push_back(with_stop(fake(3, ca, tau, "done", 0, d12), "max_tau_min"));
+  const auto refine = answer_level_round(group_cases(cases), o, 100);
+  const Stops stops = stops_by_ca(refine);
+  ASSERT_EQ(stops.size(), 3u);
+  EXPECT_EQ(stops.at(0.025), "min_D12");
+  EXPECT_EQ(stops.at(0.055), "min_D12");
+  EXPECT_EQ(std::prev(stops.end())->second, "max_tau_min") << "the CaH bisection, in (0.2, 0.5)";
+  // The dt check halves the step of the CaH-low case and keeps its stop; the check level's brackets get theirs.
+  const auto dt = dt_check_cases(group_cases(cases), o, 100);
+  ASSERT_EQ(dt.size(), 1u);
+  EXPECT_DOUBLE_EQ(dt[0].capillary_number(), 0.2);
+  EXPECT_EQ(stop_of(dt[0]), "max_tau_min");
+  o.levels = {2, 3, 4};
+  EXPECT_EQ(stops_by_ca(check_level_cases(group_cases(cases), o, 100)),
+            (Stops{{0.02, "min_D12"}, {0.03, "min_D12"}, {0.05, "min_D12"}, {0.06, "min_D12"}, {0.2, "max_tau_min"},
+                   {0.5, "max_tau_min"}}));
+}
+
+// The stop test says which answer a case waited for, not what it computes: cases that differ in it only share a
+// group (one sample per Ca: the one that waited for both, then the first), and it is in the identity only when set.
+TEST(MultiFidelity, CasesThatDifferInTheirStopTestShareAGroup) {
+  const auto stopping = [](CaseSample c, const std::string& stop, double tau) {
+    c.params.set("time.stop_test", stop);
+    c.case_id += "-" + stop;
+    c.max_tau_min = tau;
+    return c;
+  };
+  const CaseSample plain = fake(3, 0.5, [](double) { return -1.0; });
+  EXPECT_EQ(group_key(plain.params), group_key(stopping(plain, "min_D12", 0).params));
+  EXPECT_NE(plain.params.identity("2"), stopping(plain, "min_D12", 0).params.identity("2"));
+  EXPECT_EQ(plain.params.identity("2"), stopping(plain, "both", 0).params.identity("2"))
+      << "the default is not in the identity";
+  for (const bool plain_first : {true, false}) {
+    const CaseSample other = stopping(plain, "max_tau_min", 1.0);
+    const auto groups = group_cases(plain_first ? std::vector<CaseSample>{plain, other}
+                                                : std::vector<CaseSample>{other, plain});
+    ASSERT_EQ(groups.size(), 1u);
+    ASSERT_EQ(groups[0].samples.size(), 1u) << "one sample per Ca";
+    EXPECT_EQ(*groups[0].samples[0].max_tau_min, -1.0) << "the one that waited for both, plain first " << plain_first;
+    EXPECT_EQ(groups[0].samples[0].stop_test, "both");
+  }
+  const auto one = group_cases({stopping(plain, "min_D12", 0.5)});
+  ASSERT_EQ(one[0].samples.size(), 1u);
+  EXPECT_EQ(one[0].samples[0].stop_test, "min_D12");
 }
 
 TEST(MultiFidelity, BisectionsSavedCountsWhatRefinementToTheToleranceWouldStillRun) {

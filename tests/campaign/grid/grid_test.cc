@@ -237,6 +237,14 @@ TEST(Grid, MultiFidelityLevelsSetTheScanLevel) {
   bad(head + "levels = [2, 3]\ncheck_precision = 'mixed'\n", "needs a check level");
   bad(head + "levels = [2, 3, 4]\ncheck_precision = 'half'\n", "check_precision");
   bad(head + "levels = [2, 3, 4]\ncheck_precision = 1\n", "expected a string");
+  // stop_for_answer: the answer level's cases stop on their answer (analysis/multi_fidelity.h).
+  const auto stop = parse_campaign(head + "levels = [2, 3]\nstop_for_answer = true\n", "mf.toml");
+  EXPECT_TRUE(stop.analysis.stop_for_answer);
+  EXPECT_FALSE(spec.analysis.stop_for_answer) << "off by default";
+  EXPECT_NE(stop.to_json().find("\"stop_for_answer\":true"), std::string::npos) << stop.to_json();
+  EXPECT_EQ(spec.to_json().find("stop_for_answer"), std::string::npos) << "stored only when set";
+  bad(head + "stop_for_answer = true\n", "needs [analysis] levels");
+  bad(head + "levels = [2, 3]\nstop_for_answer = 'yes'\n", "expected true or false");
   bad("[campaign]\nname='mf'\n[defaults]\nmesh.level = 3\n[[grid]]\ncapillary_number=[0.1]\n[analysis]\nlevels = [2, 3]\n",
       "[defaults] mesh.level");
   bad("[campaign]\nname='mf'\n[[grid]]\ncapillary_number=[0.1]\nmesh_level=[2]\n[analysis]\nlevels = [2, 3]\n",

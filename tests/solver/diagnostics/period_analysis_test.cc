@@ -380,6 +380,39 @@ TEST(PeriodicConvergence, DetectsAChangingPeriod) {
   EXPECT_TRUE(periodic_regime_converged(a, loose));
 }
 
+TEST(PeriodicConvergence, StopTestComparesOnlyTheAnswersItNames) {
+  // Swinging with a constant period; one answer settled from the start, the other's amplitude still decaying
+  // (successive maxima differ by ≈ 1e-2 near t = 30, far above the tolerance 1e-3).
+  auto swinging = [](bool d12_settles) {
+    return [d12_settles](double t, double& d, double& th, double& tau) {
+      const double phase = 2 * kPi * t / 6.0, decay = 0.1 * std::exp(-t / 15);
+      d = 0.3 + (d12_settles ? 0.1 : 0.1 + decay) * std::cos(phase);
+      th = 0.2 + 0.1 * std::sin(phase);
+      tau = 0.01 + (d12_settles ? decay : 0.0) * std::cos(phase);
+    };
+  };
+  const double tol = 1e-3;
+  const auto tau_drifts = analyse(sample(30.0, 0.01, swinging(true)));
+  ASSERT_EQ(tau_drifts.regime, Regime::swinging);
+  ASSERT_GE(tau_drifts.periods.size(), 2u);
+  EXPECT_GT(std::abs(tau_drifts.periods[0].max_tau_min - tau_drifts.periods[1].max_tau_min), 5 * tol);
+  EXPECT_FALSE(periodic_regime_converged(tau_drifts, stop_test_options("both", tol)));
+  EXPECT_TRUE(periodic_regime_converged(tau_drifts, stop_test_options("min_D12", tol)));
+  EXPECT_FALSE(periodic_regime_converged(tau_drifts, stop_test_options("max_tau_min", tol)));
+  const auto d12_drifts = analyse(sample(30.0, 0.01, swinging(false)));
+  ASSERT_EQ(d12_drifts.regime, Regime::swinging);
+  EXPECT_FALSE(periodic_regime_converged(d12_drifts, stop_test_options("both", tol)));
+  EXPECT_FALSE(periodic_regime_converged(d12_drifts, stop_test_options("min_D12", tol)));
+  EXPECT_TRUE(periodic_regime_converged(d12_drifts, stop_test_options("max_tau_min", tol)));
+  // "both" is the default test; the tolerance applies; the period is compared by every test.
+  const ConvergenceOptions both = stop_test_options("both", tol), plain;
+  EXPECT_EQ(both.tol_D12, tol);
+  EXPECT_EQ(both.tol_tau_min, tol);
+  EXPECT_EQ(both.tol_period, plain.tol_period);
+  EXPECT_EQ(stop_test_options("min_D12", tol).tol_period, plain.tol_period);
+  EXPECT_THROW(stop_test_options("D12", tol), std::invalid_argument);
+}
+
 TEST(Regime, Names) {
   EXPECT_EQ(to_string(Regime::tumbling), "tumbling");
   EXPECT_EQ(to_string(Regime::swinging), "swinging");

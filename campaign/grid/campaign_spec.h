@@ -39,8 +39,9 @@ struct AnalysisSpec {
   /// was computed, not what: the analysis puts both precisions of a group into one (transitions.h group_key).
   std::string check_precision;
   /// @brief Each case the answer and check levels add stops on the answer it is for (time.stop_test: min D12
-  /// for a Ca* edge, max τmin for CaH, both where a Ca serves both; analysis/multi_fidelity.h). Off by default:
-  /// with it the added cases have other identities, so a committed campaign would run its answer level again.
+  /// for a Ca* edge, max τmin for CaH, both where a Ca serves both; analysis/multi_fidelity.h). Off by default;
+  /// switched on for a campaign that has run, it changes only the cases added afterwards (a Ca that exists is
+  /// not proposed again, whatever its stop test).
   bool stop_for_answer = false;
 };
 

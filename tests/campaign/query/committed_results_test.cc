@@ -60,6 +60,12 @@ TEST(CommittedResults, MainCommandRunOnAvx512IsWhatTheDatabaseGives) {
                           6, true);
 }
 
+// The same with [analysis] stop_for_answer, timed on the same machine (results/main_command_stop_for_answer/).
+TEST(CommittedResults, MainCommandRunWithStopForAnswerIsWhatTheDatabaseGives) {
+  expect_query_reproduces("main_command_stop_for_answer/table1_mf_mixed.sqlite",
+                          "main_command_stop_for_answer/table1_mf_mixed.json", "", 6, true);
+}
+
 // The certified campaign shares its database with the multi-fidelity one it continues; the query's default
 // campaign is the most recently run, the certified one.
 TEST(CommittedResults, CertifiedTableIsWhatTheDatabaseGives) {

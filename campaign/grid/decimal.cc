@@ -69,8 +69,10 @@ std::string Decimal::to_string() const {
   std::int64_t m = mantissa < 0 ? -mantissa : mantissa;
   std::string digits = std::to_string(m);
   if (scale > 0) {
-    if (static_cast<int>(digits.size()) <= scale) digits.insert(0, std::string(scale - digits.size() + 1, '0'));
-    digits.insert(digits.size() - scale, ".");
+    // Concatenation, not std::string::insert: GCC 12 flags insert's inlined copy with a false -Wrestrict.
+    if (static_cast<int>(digits.size()) <= scale) digits = std::string(scale - digits.size() + 1, '0') + digits;
+    const std::size_t point = digits.size() - static_cast<std::size_t>(scale);
+    digits = digits.substr(0, point) + "." + digits.substr(point);
     while (digits.back() == '0') digits.pop_back();
     if (digits.back() == '.') digits.pop_back();
   }

@@ -75,6 +75,17 @@ inline void tile(const double* tx, const double* ty, const double* tz, const Sou
   }
 }
 
+// Sum of the 8 lanes, added in the order of GCC's _mm512_reduce_add_pd (upper half + lower half, then the
+// 128-bit halves, then the two lanes), so results are bitwise those of the intrinsic; written out because
+// GCC 12's intrinsic extracts the upper half through a masked builtin that -Wuninitialized flags.
+inline double reduce_add(__m512d v) {
+  alignas(64) double t[kLanes];
+  _mm512_store_pd(t, v);
+  const double h0 = t[4] + t[0], h1 = t[5] + t[1], h2 = t[6] + t[2], h3 = t[7] + t[3];
+  const double q0 = h2 + h0, q1 = h3 + h1;
+  return q0 + q1;
+}
+
 // One target (broadcast) against blocks of sources in lanes; Newton 1/r as in tile<·, 1>.
 inline void blocks(const double x0[3], const Sources& s, const int* begins, int count, int length, double u[3]) {
   const __m512d X = _mm512_set1_pd(x0[0]), Y = _mm512_set1_pd(x0[1]), Z = _mm512_set1_pd(x0[2]);
@@ -100,9 +111,9 @@ inline void blocks(const double x0[3], const Sources& s, const int* begins, int 
       UZ = _mm512_fmadd_pd(y, _mm512_fmadd_pd(dz, s2, qz), UZ);
     }
   }
-  u[0] += _mm512_reduce_add_pd(UX);
-  u[1] += _mm512_reduce_add_pd(UY);
-  u[2] += _mm512_reduce_add_pd(UZ);
+  u[0] += reduce_add(UX);
+  u[1] += reduce_add(UY);
+  u[2] += reduce_add(UZ);
 }
 
 #elif defined(__AVX2__) && defined(__FMA__)

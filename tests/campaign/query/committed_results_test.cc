@@ -1,6 +1,7 @@
 // The committed Table 1 files are what `capsim query table1 --format json` gives on the committed campaign
 // databases (issue 5: "capsim query table1 --db results/table1.sqlite --format json reproduces the committed
 // table"). The database is copied first so that the query cannot touch the repository's file.
+#include <algorithm>
 #include <filesystem>
 #include <string>
 
@@ -22,7 +23,11 @@ void expect_query_reproduces(const std::string& db_name, const std::string& json
   // Both files are committed deliverables: a missing one is a failure, not a reason to skip.
   ASSERT_TRUE(fs::exists(results / db_name)) << "results/" << db_name << " is missing";
   ASSERT_TRUE(fs::exists(results / json_name)) << "results/" << json_name << " is missing";
-  const std::string dir = fresh_dir("committed_" + fs::path(json_name).stem().string());
+  // One scratch folder per committed file: several databases share a file name (table1_mf_mixed.json in three
+  // folders), and ctest -j runs their tests at once.
+  std::string scratch = fs::path(json_name).replace_extension().string();
+  std::replace(scratch.begin(), scratch.end(), '/', '_');
+  const std::string dir = fresh_dir("committed_" + scratch);
   const std::string copy = dir + "/" + fs::path(db_name).filename().string();
   fs::copy_file(results / db_name, copy);
   if (reanalyse) {

@@ -61,7 +61,9 @@ TEST(MembraneLaw, NeoHookeanAndSkalakC1AgreeToFirstOrder) {
       const double diff = std::max(std::abs(a[0] - b[0]), std::abs(a[1] - b[1]));
       const double first_order = std::max(std::abs(a[0]), std::abs(a[1]));
       EXPECT_LT(diff, 20.0 * eps * first_order);
-      if (prev > 0.0) EXPECT_NEAR(prev / diff, 4.0, 0.3) << "difference must be quadratic in the strain";
+      if (prev > 0.0) {
+        EXPECT_NEAR(prev / diff, 4.0, 0.3) << "difference must be quadratic in the strain";
+      }
       prev = diff;
     }
   }

@@ -38,7 +38,9 @@ TEST(SphereMesh, EveryEdgeSharedByTwoElements) {
   for (const auto& e : m.elements)
     for (int a = 3; a < 6; ++a) ++count[e[a]];
   for (int i = 0; i < m.num_nodes(); ++i)
-    if (m.kind[i] == NodeKind::MidSide) EXPECT_EQ(count[i], 2);
+    if (m.kind[i] == NodeKind::MidSide) {
+      EXPECT_EQ(count[i], 2);
+    }
   // Node → element adjacency agrees with the element list.
   for (int i = 0; i < m.num_nodes(); ++i)
     for (int k = m.node_element_offsets[i]; k < m.node_element_offsets[i + 1]; ++k) {

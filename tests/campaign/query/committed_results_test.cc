@@ -71,6 +71,12 @@ TEST(CommittedResults, MainCommandRunWithStopForAnswerIsWhatTheDatabaseGives) {
                           "main_command_stop_for_answer/table1_mf_mixed.json", "", 6, true);
 }
 
+// The main preset with time.rkc_safety = 1.0: the stability sweep on its cases (results/rkc_safety_sweep/).
+TEST(CommittedResults, RkcSafetySweepIsWhatTheDatabaseGives) {
+  expect_query_reproduces("rkc_safety_sweep/table1_mf_mixed_rkc1.sqlite", "rkc_safety_sweep/table1_mf_mixed_rkc1.json",
+                          "", 6, true);
+}
+
 // The certified campaign shares its database with the multi-fidelity one it continues; the query's default
 // campaign is the most recently run, the certified one.
 TEST(CommittedResults, CertifiedTableIsWhatTheDatabaseGives) {

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "campaign/analysis/refinement.h"
+#include "solver/diagnostics/period_analysis.h"
 
 namespace capsim::campaign {
 
@@ -46,12 +47,26 @@ struct Proposals {
   }
 };
 
+// The stop test that waits for `need`, and back (time.stop_test; diagnostics names its values).
+std::string_view stop_test_of(unsigned need) {
+  return need == kMinD12 ? diagnostics::kStopTestMinD12
+         : need == kMaxTauMin ? diagnostics::kStopTestMaxTauMin
+                              : diagnostics::kStopTestBoth;
+}
+unsigned need_of(std::string_view stop_test) {
+  return stop_test == diagnostics::kStopTestMinD12      ? kMinD12
+         : stop_test == diagnostics::kStopTestMaxTauMin ? kMaxTauMin
+                                                        : kBoth;
+}
+
 // time.stop_test of a new case for answer(s) `need` with stop_for_answer; without it the template's.
 void set_stop_test(CaseParams& p, bool stop_for_answer, unsigned need) {
   if (!stop_for_answer) return;
-  if (need == kMinD12) p.set("time.stop_test", std::string("min_D12"));
-  else if (need == kMaxTauMin) p.set("time.stop_test", std::string("max_tau_min"));
-  else p.erase("time.stop_test");  // the default, "both": the identity of a case that never had the key
+  // The default ("both") is erased, not written: the identity of a case that never had the key.
+  if (const std::string_view name = stop_test_of(need); name == diagnostics::kStopTestBoth)
+    p.erase("time.stop_test");
+  else
+    p.set("time.stop_test", std::string(name));
 }
 
 // Appends the cases of `proposals` (template `base`, at `level`) within the budget; false once it is spent.
@@ -77,9 +92,10 @@ void add_bracketing_ca(const Transition& t, Proposals& p) {
   for (const auto& x : {t.ca_h_low, t.ca_h_high}) p.add(x, kMaxTauMin);
 }
 
-// What a refinement proposal @p x of a group with transition @p t and samples @p samples is for (the brackets
-// propose_refinement bisects): a Ca* edge's bracket, or without a band the neighbourhood of the smallest min
-// D12, needs min D12; the CaH bracket max τmin; both where they overlap (or, defensively, neither).
+// What a refinement proposal @p x of a group with transition @p t and samples @p samples is for: every answer
+// whose bracket it falls in — a Ca* edge's, or without a band the neighbourhood of the smallest min D12 (min
+// D12), the CaH bracket (max τmin), both where they overlap (or, defensively, neither). By where x lies, not
+// by which bisection proposed it: once run, x is a sample of every bracket it lies in, whichever answer asked.
 unsigned need_inside(const Transition& t, const std::vector<Sample>& samples, double x) {
   auto inside = [x](const std::optional<double>& a, const std::optional<double>& b) {
     return a && b && x > std::min(*a, *b) && x < std::max(*a, *b);
@@ -313,8 +329,7 @@ std::vector<CaseParams> dt_check_cases(const std::vector<SampleGroup>& groups, c
     p.set("flow.capillary_number", c->ca);
     p.set("time.dt", 0.5 * *c->dt);
     // The same stop as the case it halves the step of: the pair then differs by the step, not by what it waited for.
-    set_stop_test(p, o.stop_for_answer,
-                  c->stop_test == "min_D12" ? kMinD12 : c->stop_test == "max_tau_min" ? kMaxTauMin : kBoth);
+    set_stop_test(p, o.stop_for_answer, need_of(c->stop_test));
     out.push_back(std::move(p));
     --budget;
   }

@@ -163,16 +163,17 @@ std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases) {
     g.case_ca.push_back(ca);
     if (c.status != "done") continue;
     const auto& values = c.params.values();
-    auto text = [&](const char* key, const char* unset) {
+    auto text = [&](const char* key, std::string_view unset) {
       const auto v = values.find(key);
       const std::string* t = v == values.end() ? nullptr : std::get_if<std::string>(&v->second);
       return t ? *t : std::string(unset);
     };
-    const std::string stop_test = text("time.stop_test", "both");
+    const std::string stop_test = text("time.stop_test", diagnostics::kStopTestBoth);
     const Sample sample{ca, c.min_d12, c.max_tau_min, c.case_id, c.min_d12_spread, c.max_tau_min_spread, c.dt, stop_test};
     // One sample per Ca: where a Ca was run in both precisions, the double one (the reference); then the one
     // whose stop waited for both answers.
-    const int rank = 2 * (text("numerics.kernel_precision", "double") == "double") + (stop_test == "both");
+    const int rank =
+        2 * (text("numerics.kernel_precision", "double") == "double") + (stop_test == diagnostics::kStopTestBoth);
     auto& ranks = sample_rank[it->second];
     const auto same = std::find_if(g.samples.begin(), g.samples.end(), [&](const Sample& s) { return same_ca(s.ca, ca); });
     if (same == g.samples.end()) {

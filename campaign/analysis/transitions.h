@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "campaign/grid/case_params.h"
+#include "solver/diagnostics/period_analysis.h"
 
 namespace capsim::campaign {
 
@@ -74,7 +75,7 @@ struct Sample {
   std::optional<double> min_d12_spread;      ///< min_D12_period_spread of its result (nullopt: not recorded)
   std::optional<double> max_tau_min_spread;  ///< max_tau_min_period_spread of its result
   std::optional<double> dt;                  ///< time step the case ran with
-  std::string stop_test = "both";            ///< its time.stop_test (which answers its stop waited for)
+  std::string stop_test{diagnostics::kStopTestBoth};  ///< its time.stop_test (which answers its stop waited for)
 };
 
 /// @brief One case of a campaign with its result, as the store reads it (the input of the grouping).

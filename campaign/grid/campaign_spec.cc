@@ -228,15 +228,18 @@ CampaignSpec parse_campaign(const std::string& text, const std::string& source) 
         out = static_cast<int>(*x);
       }
     };
+    auto boolean = [&](const char* k, bool& out) {
+      if (auto* n = at.get(k)) {
+        auto b = n->value_exact<bool>();
+        if (!b) fail(source, std::string("[analysis] ") + k, "expected true or false, got " + toml_type_name(*n));
+        out = *b;
+      }
+    };
     number("D12_threshold", spec.analysis.d12_threshold, 0.0, 1.0);
     number("ca_tolerance", spec.analysis.ca_tolerance, 0.0, 1e6);
     integer("max_cases", spec.analysis.max_cases, 1, 100000);
     integer("max_rounds", spec.analysis.max_rounds, 1, 1000);
-    if (auto* n = at.get("adaptive")) {
-      auto b = n->value_exact<bool>();
-      if (!b) fail(source, "[analysis] adaptive", "expected true or false, got " + toml_type_name(*n));
-      spec.analysis.adaptive = *b;
-    }
+    boolean("adaptive", spec.analysis.adaptive);
     if (auto* n = at.get("levels")) {
       const auto* arr = n->as_array();
       if (!arr) fail(source, "[analysis] levels", "expected a list of 2 or 3 mesh levels, got " + toml_type_name(*n));
@@ -260,21 +263,13 @@ CampaignSpec parse_campaign(const std::string& text, const std::string& source) 
             fail(source, "[grid][" + std::to_string(b + 1) + "] mesh_level", "not allowed with [analysis] levels");
       spec.defaults.set("mesh.level", std::int64_t{spec.analysis.levels[0]});
     }
-    if (auto* n = at.get("dt_check")) {
-      auto b = n->value_exact<bool>();
-      if (!b) fail(source, "[analysis] dt_check", "expected true or false, got " + toml_type_name(*n));
-      if (*b && spec.analysis.levels.empty())
-        fail(source, "[analysis] dt_check", "needs [analysis] levels (it re-runs a case of the answer level)");
-      spec.analysis.dt_check = *b;
-    }
-    if (auto* n = at.get("stop_for_answer")) {
-      auto b = n->value_exact<bool>();
-      if (!b) fail(source, "[analysis] stop_for_answer", "expected true or false, got " + toml_type_name(*n));
-      if (*b && spec.analysis.levels.empty())
-        fail(source, "[analysis] stop_for_answer",
-             "needs [analysis] levels (it sets the stop test of the cases the answer level adds)");
-      spec.analysis.stop_for_answer = *b;
-    }
+    boolean("dt_check", spec.analysis.dt_check);
+    if (spec.analysis.dt_check && spec.analysis.levels.empty())
+      fail(source, "[analysis] dt_check", "needs [analysis] levels (it re-runs a case of the answer level)");
+    boolean("stop_for_answer", spec.analysis.stop_for_answer);
+    if (spec.analysis.stop_for_answer && spec.analysis.levels.empty())
+      fail(source, "[analysis] stop_for_answer",
+           "needs [analysis] levels (it sets the stop test of the cases the answer level adds)");
     if (auto* n = at.get("check_precision")) {
       auto v = n->value_exact<std::string>();
       if (!v) fail(source, "[analysis] check_precision", "expected a string, got " + toml_type_name(*n));

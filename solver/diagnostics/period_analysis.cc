@@ -292,12 +292,12 @@ PeriodAnalysis analyse_periods(const TimeSeries& series, const PeriodOptions& op
 ConvergenceOptions stop_test_options(std::string_view stop_test, double tolerance) {
   constexpr double kUntested = std::numeric_limits<double>::infinity();
   ConvergenceOptions o;
-  if (stop_test == "both") {
+  if (stop_test == kStopTestBoth) {
     o.tol_D12 = o.tol_tau_min = tolerance;
-  } else if (stop_test == "min_D12") {
+  } else if (stop_test == kStopTestMinD12) {
     o.tol_D12 = tolerance;
     o.tol_tau_min = kUntested;
-  } else if (stop_test == "max_tau_min") {
+  } else if (stop_test == kStopTestMaxTauMin) {
     o.tol_D12 = kUntested;
     o.tol_tau_min = tolerance;
   } else {

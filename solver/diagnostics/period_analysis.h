@@ -43,6 +43,11 @@ struct ConvergenceOptions {
   int periods = 2;            ///< number of successive periods that must agree pairwise (≥ 2)
 };
 
+/// @brief The values of time.stop_test, named once (the key registry, solver/config/case_keys.def, accepts
+/// exactly these; PeriodicConvergence.StopTestNamesAreTheRegistrysValues checks it).
+inline constexpr std::string_view kStopTestBoth = "both", kStopTestMinD12 = "min_D12",
+                                  kStopTestMaxTauMin = "max_tau_min";
+
 /// @brief The stop test of a case: @p tolerance on the answers @p stop_test names (time.stop_test: "both",
 /// "min_D12" or "max_tau_min"); the other one gets an infinite tolerance, i.e. is not compared (a Table 1
 /// answer needs only one of them: a Ca* edge min D12, CaH max τmin). The period is compared in every case.

@@ -1,6 +1,9 @@
 // Period, extrema and regime detection on synthetic signals with known answers.
 #include "solver/diagnostics/period_analysis.h"
 
+#include <string>
+#include <variant>
+
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -8,6 +11,8 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include "solver/config/case_keys.h"
 
 namespace capsim::diagnostics {
 namespace {
@@ -411,6 +416,16 @@ TEST(PeriodicConvergence, StopTestComparesOnlyTheAnswersItNames) {
   EXPECT_EQ(both.tol_period, plain.tol_period);
   EXPECT_EQ(stop_test_options("min_D12", tol).tol_period, plain.tol_period);
   EXPECT_THROW(stop_test_options("D12", tol), std::invalid_argument);
+}
+
+// The names the solver and the campaign use are the values the key registry accepts, no more, no fewer.
+TEST(PeriodicConvergence, StopTestNamesAreTheRegistrysValues) {
+  const config::CaseKey* key = config::find_case_key("time.stop_test");
+  ASSERT_NE(key, nullptr);
+  EXPECT_EQ(key->rule.words, (std::vector<std::string>{std::string(kStopTestBoth), std::string(kStopTestMinD12),
+                                                       std::string(kStopTestMaxTauMin)}));
+  EXPECT_EQ(std::get<std::string>(key->default_value), kStopTestBoth);
+  for (const auto& name : key->rule.words) EXPECT_NO_THROW(stop_test_options(name, 1e-3)) << name;
 }
 
 TEST(Regime, Names) {

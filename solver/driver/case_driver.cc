@@ -183,6 +183,7 @@ class CaseRun {
     std::string failure;
     bool stepped = false;
     try {
+      flow_->begin_step();  // no load carried into a step: a resumed run repeats this one bitwise
       info = integrator_->step(*flow_, next_, dt_, snapshot_due ? &start_ : nullptr);
       if (keep_mirror_) mesh::symmetrise(mesh(), next_);
       stepped = true;

@@ -23,6 +23,8 @@ CapsuleFlow::CapsuleFlow(const config::CaseConfig& c) : Ca_(c.capillary_number) 
                                                              membrane::MembraneMechanics::Options{c.membrane_degree});
   membrane::LoadSolver::Options lo;
   lo.quadrature_degree = c.membrane_degree;
+  lo.cg_tolerance = c.load_tolerance;
+  load_warm_start_ = c.load_warm_start;
   load_solver_ = std::make_unique<membrane::LoadSolver>(*mesh_, lo);
   if (c.bending_modulus > 0.0)
     bending_ = std::make_unique<membrane::BendingMechanics>(*mesh_, mesh_->nodes,
@@ -41,6 +43,10 @@ CapsuleFlow::CapsuleFlow(const config::CaseConfig& c) : Ca_(c.capillary_number) 
 CapsuleFlow::~CapsuleFlow() = default;
 
 membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q) {
+  return membrane_load(x, q, false);
+}
+
+membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q, bool warm) {
   auto t0 = std::chrono::steady_clock::now();
   membrane::MembraneState s = mechanics_->evaluate(x);
   timings_.membrane_s += seconds_since(t0);
@@ -54,9 +60,9 @@ membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Ei
   }
   try {
     if (bending_)
-      load_solver_->solve(s.internal_force + bending_state_.internal_force, q);
+      load_solver_->solve(s.internal_force + bending_state_.internal_force, q, warm);
     else
-      load_solver_->compute_load(x, s.internal_force, q);
+      load_solver_->compute_load(x, s.internal_force, q, warm);
   } catch (const std::runtime_error& e) {
     throw membrane::DegenerateSurface(e.what());
   }
@@ -66,7 +72,11 @@ membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Ei
 
 FlowEvaluation CapsuleFlow::velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, Eigen::Matrix3Xd* load) {
   FlowEvaluation out;
-  const membrane::MembraneState s = membrane_load(x, q_);
+  // q_ holds the previous evaluation's load (a valid one only while load_guess_): the warm start's guess.
+  const bool warm = load_warm_start_ && load_guess_;
+  load_guess_ = false;  // until this solve has succeeded
+  const membrane::MembraneState s = membrane_load(x, q_, warm);
+  load_guess_ = true;
   out.tau_min = s.tau_min;
   out.tau_max = s.tau_max;
   out.bending_energy = bending_state_.energy;

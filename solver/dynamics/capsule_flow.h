@@ -89,6 +89,11 @@ class CapsuleFlow {
   [[nodiscard]] stokes::SingleLayer& single_layer() { return *single_layer_; }
   /// @brief Switch the undisturbed shear flow v∞ off (fluid at rest: relaxation tests) or on (default).
   void set_background_flow(bool on) { background_flow_ = on; }
+  /// @brief A time step begins: with numerics.load_warm_start, the next `velocity` starts its load solve from
+  /// zero again (later ones from the previous evaluation's load). The driver calls it before every step, so
+  /// that nothing carried between steps is missing from a checkpoint and a resumed run repeats an
+  /// uninterrupted one bitwise. Without the warm start it changes nothing.
+  void begin_step() { load_guess_ = false; }
 
  private:
   double Ca_;
@@ -100,9 +105,12 @@ class CapsuleFlow {
   membrane::BendingState bending_state_;
   std::unique_ptr<stokes::SingleLayer> single_layer_;
   Eigen::Matrix3Xd q_, u_;
+  bool load_warm_start_ = false;  // numerics.load_warm_start
+  bool load_guess_ = false;       // q_ is the load of a successful evaluation since the last begin_step()
   FlowTimings timings_;
   bool background_flow_ = true;
   bool volume_correction_ = true;
+  membrane::MembraneState membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q, bool warm);
   // Rule of the flux integral: shape functions and derivatives at its points, weights · ½.
   mesh::P2Tabulation flux_rule_;  // degree-6 rule of the volume-flux integral
   Eigen::Matrix3Xd normals_;

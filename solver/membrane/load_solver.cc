@@ -20,6 +20,7 @@ struct LoadSolver::Impl {
   std::vector<double> r, z, p, t;                            // CG work arrays, node-major (3 per node)
   std::vector<double> local;                                 // element mass matrices of the last assembly
   std::vector<double> partial;                               // CG: per-block partial dot products
+  Eigen::Matrix3Xd residual, correction;                     // warm start: R − M q0 and its solution δ
   mesh::P2Tabulation p2;                                     // the rule's points
 };
 
@@ -110,19 +111,34 @@ void LoadSolver::factorize() {
 
 
 
-void LoadSolver::solve(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
+void LoadSolver::solve(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, bool warm) {
   const Eigen::MatrixX3d rhs = R.transpose();
   if (options_.backend == Backend::Cholmod) {
     q = impl_->cholmod.solve(rhs).transpose();
     last_iterations_ = 0;
     // CHOLMOD's positive-definiteness test lets a NaN matrix through (NaN pivots compare false).
     if (!q.allFinite()) throw DegenerateSurface("CHOLMOD: non-finite load (surface degenerated)");
+  } else if (warm && q.rows() == 3 && q.cols() == R.cols()) {
+    // From the guess q0: CG from zero on the correction, M δ = R − M q0, stopped at the same residual
+    // tolerance · |R_c| as a cold solve (the cold path below stays the plain loop, bitwise as before).
+    double reference2[3];
+    Impl& w = *impl_;
+    w.residual.noalias() = R - q * M_;  // M is symmetric: (M q0ᵀ)ᵀ = q0 M
+    for (int c = 0; c < 3; ++c) {
+      reference2[c] = R.row(c).squaredNorm();
+      if (reference2[c] == 0.0) {  // a zero component has the solution 0
+        q.row(c).setZero();
+        w.residual.row(c).setZero();
+      }
+    }
+    solve_cg(w.residual, w.correction, reference2);
+    q += w.correction;
   } else {
     solve_cg(R, q);
   }
 }
 
-void LoadSolver::solve_cg(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
+void LoadSolver::solve_cg(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, const double* reference2) {
   // Jacobi-preconditioned CG from a zero guess on the three load components side by side: three independent
   // CGs (each with its own α, β and stopping test |r_c| < tol |R_c|, Eigen's criterion) that share every
   // pass over M. A component that has converged is frozen.
@@ -202,7 +218,7 @@ void LoadSolver::solve_cg(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
     }
     for (int c = 0; c < 3; ++c) {
       const double bb = total(part_rr, c);
-      th[c] = options_.cg_tolerance * options_.cg_tolerance * bb;
+      th[c] = options_.cg_tolerance * options_.cg_tolerance * (reference2 ? reference2[c] : bb);
       rz[c] = total(part_rz, c);
       act[c] = bb > 0.0;  // a zero component has the solution 0
     }
@@ -283,10 +299,11 @@ void LoadSolver::solve_cg(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
                               " iterations): the mass matrix is not positive definite (surface degenerated)");
 }
 
-void LoadSolver::compute_load(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q) {
+void LoadSolver::compute_load(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q,
+                              bool warm) {
   assemble(x);
   factorize();
-  solve(R, q);
+  solve(R, q, warm);
 }
 
 }  // namespace capsim::membrane

@@ -24,8 +24,8 @@ class LoadSolver {
   /// @brief Linear-solver backend for the mass matrix.
   enum class Backend {
     Cholmod,            ///< sparse Cholesky (SuiteSparse CHOLMOD), symbolic analysis cached
-    ConjugateGradient,  ///< Jacobi-preconditioned CG from a zero initial guess (deterministic, so a resumed
-                        ///< run repeats an uninterrupted one bitwise)
+    ConjugateGradient,  ///< Jacobi-preconditioned CG from a zero initial guess, or on the correction to
+                        ///< the caller's guess (solve's `warm`); deterministic either way
   };
   /// The default is CG: a mass matrix has a condition number bounded independently of h, so CG needs the
   /// same few dozen iterations at every level and is several times faster than CHOLMOD's numeric
@@ -34,7 +34,8 @@ class LoadSolver {
   struct Options {
     Backend backend = Backend::ConjugateGradient;
     int quadrature_degree = 6;      ///< exact for P2×P2 on flat elements
-    double cg_tolerance = 1e-12;    ///< relative residual for the CG backend
+    double cg_tolerance = 1e-12;    ///< relative residual |R − M q| / |R| of the CG backend
+                                    ///< (numerics.load_tolerance)
   };
 
   LoadSolver(const mesh::SurfaceMesh& mesh, Options options);
@@ -48,9 +49,12 @@ class LoadSolver {
   /// @brief Numeric factorisation (Cholmod) or preconditioner update (CG) of the last assembled M.
   void factorize();
   /// @brief q = M⁻¹ R for the last factorised M (columns are nodes).
-  void solve(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q);
-  /// @brief assemble(x), factorize(), solve(R, q) in one call.
-  void compute_load(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q);
+  /// @param warm CG only: start from q's current values (a load of the same mesh, e.g. the previous stage's:
+  ///        the iterations then only remove the change, to the same relative residual cg_tolerance · |R|)
+  ///        instead of zero. Ignored by Cholmod, and when q is not 3 × nodes.
+  void solve(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, bool warm = false);
+  /// @brief assemble(x), factorize(), solve(R, q, warm) in one call.
+  void compute_load(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, bool warm = false);
 
   /// @brief The last assembled mass matrix (lower and upper parts stored).
   [[nodiscard]] const Eigen::SparseMatrix<double>& mass_matrix() const { return M_; }
@@ -58,7 +62,8 @@ class LoadSolver {
   [[nodiscard]] int last_iterations() const { return last_iterations_; }
 
  private:
-  void solve_cg(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q);
+  // CG from zero, stopped at |r_c|² < cg_tolerance² · reference2[c] (nullptr: |R_c|²).
+  void solve_cg(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, const double* reference2 = nullptr);
   struct Impl;
   const mesh::SurfaceMesh& mesh_;
   Options options_;

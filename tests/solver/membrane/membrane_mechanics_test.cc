@@ -177,6 +177,50 @@ TEST(LoadSolver, CholmodAndConjugateGradientAgree) {
   EXPECT_NEAR(direct.mass_matrix().sum(), area_and_volume(m, x).area, 1e-12);
 }
 
+// numerics.load_warm_start: CG on the correction to a guess stops at the same residual |R − M q| ≤ tol |R|
+// as a cold solve, so it gives the cold answer to the tolerance, in fewer iterations when the guess is close
+// (the previous stage's load), and the exact guess needs no more than one iteration per component.
+TEST(LoadSolver, WarmStartMeetsTheColdResidualInFewerIterations) {
+  const auto m = mesh::make_capsule_mesh(2, 2.0);
+  const SkalakLaw law(1.0);
+  const MembraneMechanics mech(m, m.nodes, law);
+  const double tol = 1e-10;
+  const Matrix3Xd x0 = smooth_deformation(m.nodes, 0.2), x1 = smooth_deformation(m.nodes, 0.201);
+  const Matrix3Xd R0 = mech.evaluate(x0).internal_force, R1 = mech.evaluate(x1).internal_force;
+  LoadSolver direct(m, {LoadSolver::Backend::Cholmod, 6, 1e-12});
+  LoadSolver cg(m, {LoadSolver::Backend::ConjugateGradient, 6, tol});
+  Matrix3Xd exact1, cold1, q;
+  direct.compute_load(x1, R1, exact1);
+  cg.compute_load(x1, R1, cold1);
+  const int cold_iterations = cg.last_iterations();
+  cg.compute_load(x0, R0, q);    // the previous "stage"
+  cg.compute_load(x1, R1, q, true);  // warm from it
+  const int warm_iterations = cg.last_iterations();
+  EXPECT_LT(warm_iterations, cold_iterations);
+  EXPECT_GT(warm_iterations, 0);
+  const Matrix3Xd residual = R1 - q * cg.mass_matrix();
+  for (int c = 0; c < 3; ++c) EXPECT_LE(residual.row(c).norm(), tol * R1.row(c).norm()) << "component " << c;
+  const double scale = exact1.cwiseAbs().maxCoeff();
+  EXPECT_LT((q - exact1).cwiseAbs().maxCoeff(), 1e3 * tol * scale);
+  EXPECT_LT((q - cold1).cwiseAbs().maxCoeff(), 1e3 * tol * scale);
+  // From the exact solution: at most one iteration per component, and the answer stays.
+  q = exact1;
+  cg.compute_load(x1, R1, q, true);
+  EXPECT_LE(cg.last_iterations(), 3);
+  EXPECT_LT((q - exact1).cwiseAbs().maxCoeff(), 1e3 * tol * scale);
+  // A zero component of R has the load 0, whatever the guess; a guess of the wrong size is ignored (cold).
+  Matrix3Xd R_flat = R1;
+  R_flat.row(2).setZero();
+  q = exact1;
+  cg.compute_load(x1, R_flat, q, true);
+  EXPECT_EQ(q.row(2).cwiseAbs().maxCoeff(), 0.0);
+  Matrix3Xd wrong(3, 5);
+  wrong.setConstant(1.0);
+  cg.compute_load(x1, R1, wrong, true);
+  EXPECT_EQ(cg.last_iterations(), cold_iterations);
+  EXPECT_EQ(wrong, cold1) << "a cold solve is the same computation every time";
+}
+
 // solver/README.md §2: the tension along the larger stretch is not always the larger one. Skalak's
 // τ1 − τ2 = (λ1² + λ2² − 1)(λ1/λ2 − λ2/λ1) changes sign when λ1² + λ2² < 1 (strong compression), so
 // τmin must be the smaller of the two, not the second. An anisotropic compression of the sphere by

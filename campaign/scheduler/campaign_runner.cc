@@ -354,7 +354,8 @@ int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& 
     // The phases of analysis/multi_fidelity.h, the first that has something to add.
     const auto& lv = spec.analysis.levels;
     const MultiFidelityOptions mf{lv, spec.analysis.d12_threshold, spec.analysis.ca_tolerance, spec.analysis.adaptive,
-                                  spec.analysis.dt_check, spec.analysis.check_precision, spec.analysis.stop_for_answer};
+                                  spec.analysis.dt_check, spec.analysis.check_precision, spec.analysis.stop_for_answer,
+                                  spec.analysis.ca_star_dt_accuracy};
     // A top-up while cases run or wait (Runner::set_top_up): the same phases, once only check-level cases are left.
     if (unfinished_levels && !rounds_may_overlap(mf, *unfinished_levels)) return 0;
     add = answer_level_round(groups, mf, budget);

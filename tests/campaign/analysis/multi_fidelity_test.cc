@@ -391,6 +391,77 @@ TEST(MultiFidelity, StopForAnswerGivesEachNewCaseTheStopTestOfItsAnswer) {
                    {0.5, "max_tau_min"}}));
 }
 
+// time.dt_accuracy of a new case: "(unset)" where the key is absent (the template's step).
+std::string accuracy_of(const CaseParams& p) {
+  const auto it = p.values().find("time.dt_accuracy");
+  return it == p.values().end() ? "(unset)" : std::to_string(std::get<double>(it->second));
+}
+
+std::map<double, std::string> accuracy_by_ca(const std::vector<CaseParams>& cases) {
+  std::map<double, std::string> out;
+  for (const auto& p : cases) out[p.capillary_number()] = accuracy_of(p);
+  return out;
+}
+
+// [analysis] ca_star_dt_accuracy: the cases only a Ca* edge needs take the larger accuracy step, every other new
+// case the cell's; they share a group with the rest of their level; the dt check halves the cell's coarsest step.
+// The scan level of StopForAnswerGivesEachNewCaseTheStopTestOfItsAnswer: a band at [0.03, 0.05], CaH in (0.2, 0.5).
+TEST(MultiFidelity, CaStarDtAccuracyGivesCaStarCasesTheLargerStepAndTheDtCheckHalvesIt) {
+  const auto d12 = [](double ca) { return ca >= 0.029 && ca <= 0.051 ? 0.03 : 0.2; };
+  const auto tau = [](double ca) { return 0.3 - ca; };
+  std::vector<CaseSample> cases;
+  for (double ca : {0.01, 0.02, 0.03, 0.05, 0.06, 0.2, 0.5, 1.0}) cases.push_back(fake(2, ca, tau, "done", 0, d12));
+  MultiFidelityOptions o = kOptions;
+  o.stop_for_answer = true;
+  using Steps = std::map<double, std::string>;
+  const std::string coarse = std::to_string(0.04);
+  EXPECT_EQ(accuracy_by_ca(answer_level_round(group_cases(cases), o, 100)),
+            (Steps{{0.02, "(unset)"}, {0.03, "(unset)"}, {0.05, "(unset)"}, {0.06, "(unset)"}, {0.2, "(unset)"},
+                   {0.5, "(unset)"}}))
+      << "off: every case keeps its template's step";
+  o.ca_star_dt_accuracy = 0.04;
+  EXPECT_EQ(accuracy_by_ca(answer_level_round(group_cases(cases), o, 100)),
+            (Steps{{0.02, coarse}, {0.03, coarse}, {0.05, coarse}, {0.06, coarse}, {0.2, "(unset)"}, {0.5, "(unset)"}}));
+  // The answer level's seeds, the Ca* ones first (so the group's template is a coarse-stepped case): one group,
+  // and the CaH bisection still gets the cell's step, not its template's.
+  auto coarse_case = [&](double ca) {
+    CaseSample c = fake(3, ca, tau, "done", 0, d12);
+    c.params.set("time.stop_test", std::string("min_D12"));
+    c.params.set("time.dt_accuracy", 0.04);
+    c.dt = 0.04;
+    return c;
+  };
+  for (double ca : {0.02, 0.03, 0.05, 0.06}) cases.push_back(coarse_case(ca));
+  for (double ca : {0.2, 0.5}) {
+    cases.push_back(fake(3, ca, tau, "done", 0, d12));
+    cases.back().params.set("time.stop_test", std::string("max_tau_min"));
+  }
+  const auto groups = group_cases(cases);
+  ASSERT_EQ(groups.size(), 2u) << "one group per level, whatever the step";
+  const Steps steps = accuracy_by_ca(answer_level_round(groups, o, 100));
+  ASSERT_EQ(steps.size(), 3u);
+  EXPECT_EQ(steps.at(0.025), coarse);
+  EXPECT_EQ(steps.at(0.055), coarse);
+  EXPECT_EQ(std::prev(steps.end())->second, "(unset)") << "the CaH bisection, in (0.2, 0.5)";
+  // The dt check: the Ca*-low case (step 0.04) rather than the CaH-low one (0.02), at 0.02, with its stop.
+  const auto dt = dt_check_cases(groups, o, 100);
+  ASSERT_EQ(dt.size(), 1u);
+  EXPECT_DOUBLE_EQ(dt[0].capillary_number(), 0.03);
+  EXPECT_NE(dt[0].canonical().find("time.dt=0.02"), std::string::npos) << dt[0].canonical();
+  EXPECT_EQ(stop_of(dt[0]), "min_D12");
+  EXPECT_EQ(accuracy_of(dt[0]), "(unset)") << "an explicit step: the accuracy step does not act";
+  // Equal steps: the CaH-low case, as without the option.
+  std::vector<CaseSample> equal(cases.begin(), cases.begin() + 8);
+  for (double ca : {0.02, 0.03, 0.05, 0.06, 0.2, 0.5}) equal.push_back(fake(3, ca, tau, "done", 0, d12));
+  const auto dt_equal = dt_check_cases(group_cases(equal), o, 100);
+  ASSERT_EQ(dt_equal.size(), 1u);
+  EXPECT_DOUBLE_EQ(dt_equal[0].capillary_number(), 0.2);
+  // The check level's brackets: the same rule.
+  o.levels = {2, 3, 4};
+  EXPECT_EQ(accuracy_by_ca(check_level_cases(groups, o, 100)),
+            (Steps{{0.02, coarse}, {0.03, coarse}, {0.05, coarse}, {0.06, coarse}, {0.2, "(unset)"}, {0.5, "(unset)"}}));
+}
+
 // The stop test says which answer a case waited for, not what it computes: cases that differ in it only share a
 // group (one sample per Ca: the one that waited for both, then the first), and it is in the identity only when set.
 TEST(MultiFidelity, CasesThatDifferInTheirStopTestShareAGroup) {

@@ -88,10 +88,9 @@ class Runner {
         host_(host_name()) {}
 
   /// The next round's cases, asked for when a worker is free (at the start and each time a case ends) and
-  /// cases are still running or queued: called with the mesh levels of those cases (the running and the
-  /// queued), returns how many cases it added to the campaign (refine_campaign's top-up). New cases join the
-  /// queue in --order.
-  using TopUp = std::function<int(const std::vector<int>& unfinished_levels)>;
+  /// cases are still running or queued: called with those cases (the running and the queued), returns how
+  /// many cases it added to the campaign (refine_campaign's top-up). New cases join the queue in --order.
+  using TopUp = std::function<int(const std::vector<CaseParams>& unfinished)>;
   void set_top_up(TopUp top_up) { top_up_ = std::move(top_up); }
 
   /// Runs every queued case of the campaign (and what the top-up adds meanwhile); returns false if stopped
@@ -128,10 +127,10 @@ class Runner {
       if (top_up_ && top_up_due && !g_stop_signal && (!pending.empty() || !running_.empty()) &&
           static_cast<int>(running_.size()) < jobs_) {
         top_up_due = false;
-        std::vector<int> levels;
-        for (const auto& [_, r] : running_) levels.push_back(r.row.params.mesh_level());
-        for (const auto& r : pending) levels.push_back(r.params.mesh_level());
-        if (top_up_(levels) > 0) {
+        std::vector<CaseParams> unfinished;
+        for (const auto& [_, r] : running_) unfinished.push_back(r.row.params);
+        for (const auto& r : pending) unfinished.push_back(r.params);
+        if (top_up_(unfinished) > 0) {
           rows = store_.campaign_cases(campaign_id_);
           pending = startable(rows);  // the queue with the new cases, in --order
           order(pending);
@@ -345,9 +344,9 @@ bool reanalyse_campaign(Store& store, std::int64_t campaign_id) {
 }
 
 int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir,
-                    std::string* what, const std::vector<int>* unfinished_levels) {
+                    std::string* what, const std::vector<CaseParams>* unfinished, std::map<std::string, int>* cell_rounds) {
   const int budget = spec.analysis.max_cases - store.count_campaign_cases(campaign_id, "adaptive");
-  const auto groups = group_cases(store.campaign_samples(campaign_id));
+  auto groups = group_cases(store.campaign_samples(campaign_id));
   std::vector<CaseParams> add;
   std::string phase = "adaptive refinement";
   if (!spec.analysis.levels.empty()) {
@@ -356,8 +355,26 @@ int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& 
     const MultiFidelityOptions mf{lv, spec.analysis.d12_threshold, spec.analysis.ca_tolerance, spec.analysis.adaptive,
                                   spec.analysis.dt_check, spec.analysis.check_precision, spec.analysis.stop_for_answer,
                                   spec.analysis.ca_star_dt_accuracy};
-    // A top-up while cases run or wait (Runner::set_top_up): the same phases, once only check-level cases are left.
-    if (unfinished_levels && !rounds_may_overlap(mf, *unfinished_levels)) return 0;
+    // A top-up while cases run or wait (Runner::set_top_up): the same phases for every cell once only check-level
+    // cases are left (rounds_may_overlap); before that, for the cells none of whose cases runs or waits. A cell's
+    // phases read only its own cases, so it takes the round it would take after a global barrier, only sooner:
+    // the same cases, without a worker idling until the slowest cell's round ends.
+    if (unfinished) {
+      std::vector<int> levels;
+      for (const auto& p : *unfinished) levels.push_back(p.mesh_level());
+      if (!rounds_may_overlap(mf, levels)) {
+        std::set<std::string> busy;
+        for (const auto& p : *unfinished) busy.insert(cell_key(group_key(p)));
+        std::erase_if(groups, [&](const SampleGroup& g) { return busy.count(cell_key(g.key.group_key)) > 0; });
+      }
+    }
+    // Each cell takes at most max_rounds answer-level rounds and two more (the dt check, the check level).
+    if (cell_rounds)
+      std::erase_if(groups, [&](const SampleGroup& g) {
+        const auto it = cell_rounds->find(cell_key(g.key.group_key));
+        return it != cell_rounds->end() && it->second >= spec.analysis.max_rounds + 2;
+      });
+    if (groups.empty()) return 0;
     add = answer_level_round(groups, mf, budget);
     phase = "multi-fidelity: level " + std::to_string(lv[1]) + " (seed, re-bracket" +
             (spec.analysis.adaptive ? ", refine)" : ")");
@@ -372,6 +389,7 @@ int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& 
       phase = "multi-fidelity: mesh check on level " + std::to_string(lv[2]);
     }
   } else {
+    if (unfinished) return 0;  // the top-up is for multi-fidelity rounds only
     add = refinement_round(groups, spec.analysis.d12_threshold, spec.analysis.ca_tolerance, budget);
   }
   if (what) *what = phase;
@@ -379,6 +397,11 @@ int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& 
   Transaction t(store.db());
   const int added = store.add_cases(campaign_id, add, "adaptive", runs_dir);
   t.commit();
+  if (cell_rounds) {
+    std::set<std::string> cells;
+    for (const auto& p : add) cells.insert(cell_key(group_key(p)));
+    for (const auto& c : cells) ++(*cell_rounds)[c];
+  }
   return added;
 }
 
@@ -560,28 +583,31 @@ int run_campaign(const RunOptions& opt, const BeforeRun& before_run) {
   // that tops up the queue while check-level cases run counts like any other.
   const int rounds = spec.analysis.max_rounds + (spec.analysis.levels.empty() ? 0 : 2);
   int rounds_done = 0;
-  // With a check level, once only check-level cases are left running or queued (they take hours on level 4),
-  // a free worker asks for the next round's cases instead of waiting for the round to end (rounds_may_overlap):
-  // a level-3 refinement or a check case a finished one calls for joins the queue in --order.
-  if (spec.analysis.levels.size() > 2)
-    runner.set_top_up([&](const std::vector<int>& unfinished_levels) {
-      if (rounds_done >= rounds) return 0;
+  // Multi-fidelity: a free worker asks for the next round's cases instead of waiting for the round to end —
+  // of the cells none of whose cases runs or waits, or of every cell once only check-level cases are left
+  // (they take hours on level 4; rounds_may_overlap): a cell's seeds, bisections, dt check or check cases join
+  // the queue in --order as soon as its own cases are done. The round limit is then per cell (cell_rounds).
+  std::map<std::string, int> cell_rounds;
+  const bool multi_fidelity = !spec.analysis.levels.empty();
+  if (multi_fidelity)
+    runner.set_top_up([&](const std::vector<CaseParams>& unfinished) {
       std::string what;
-      const int added = refine_campaign(*store, campaign_id, spec, runs_dir, &what, &unfinished_levels);
+      const int added = refine_campaign(*store, campaign_id, spec, runs_dir, &what, &unfinished, &cell_rounds);
       if (added > 0) {
         ++rounds_done;
         runner.message("capsim campaign: round " + std::to_string(rounds_done) + ", " + what + ", while " +
-                       std::to_string(unfinished_levels.size()) + " case(s) run or wait: " + std::to_string(added) +
+                       std::to_string(unfinished.size()) + " case(s) run or wait: " + std::to_string(added) +
                        " case(s) added");
       }
       return added;
     });
   bool completed = runner.run_queued();
-  const std::string method = analysis_method(spec.analysis.adaptive, !spec.analysis.levels.empty());
-  if (completed && (spec.analysis.adaptive || !spec.analysis.levels.empty())) {
-    while (rounds_done < rounds && completed) {
+  const std::string method = analysis_method(spec.analysis.adaptive, multi_fidelity);
+  if (completed && (spec.analysis.adaptive || multi_fidelity)) {
+    while ((multi_fidelity || rounds_done < rounds) && completed) {
       std::string what;
-      int added = refine_campaign(*store, campaign_id, spec, runs_dir, &what);
+      int added = refine_campaign(*store, campaign_id, spec, runs_dir, &what, nullptr,
+                                  multi_fidelity ? &cell_rounds : nullptr);
       if (added == 0) break;
       ++rounds_done;
       runner.message(spec.analysis.levels.empty()

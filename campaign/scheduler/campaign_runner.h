@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -97,11 +98,14 @@ bool reanalyse_campaign(Store& store, std::int64_t campaign_id);
 /// cases it added to the campaign (0: nothing left to refine).
 /// With [analysis] levels, the next phase of analysis/multi_fidelity.h that adds cases (answer-level rounds,
 /// then the dt check, then the check level); @p what, if given, names the phase.
-/// With @p unfinished_levels (the mesh levels of the cases still running or queued): the same, but only when
-/// every one of them is a check-level case (analysis/multi_fidelity.h, rounds_may_overlap), else 0 — the
-/// top-up that lets the next round's cases join a queue of hours-long check-level cases.
+/// With @p unfinished (the cases still running or queued; multi-fidelity only, else 0): the same for the cells
+/// none of whose cases is among them — or for every cell when all of them are check-level cases
+/// (analysis/multi_fidelity.h, rounds_may_overlap) — the top-up that lets a cell take its next round while
+/// other cells' cases run. With @p cell_rounds (multi-fidelity): cells that have had max_rounds + 2 rounds
+/// take none, and each cell that gets cases counts one more round.
 int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir,
-                    std::string* what = nullptr, const std::vector<int>* unfinished_levels = nullptr);
+                    std::string* what = nullptr, const std::vector<CaseParams>* unfinished = nullptr,
+                    std::map<std::string, int>* cell_rounds = nullptr);
 
 /// @brief Writes @p text to @p path via a temporary file in the same folder and rename (atomic).
 void write_file_atomic(const std::string& path, const std::string& text);

@@ -199,5 +199,46 @@ TEST(MultiFidelity, AFreeWorkerTakesTheCheckLevelsNextCaseWhileALongOneRuns) {
   EXPECT_EQ(table(dir + "/one.db"), table(dir + "/plain.db"));
 }
 
+// Cells advance independently: a cell whose own cases are done takes its next round while another cell's cases
+// still run, instead of waiting for the round of every cell to end. Two cells (oblate and prolate NH, answer level
+// 2, dt check); one oblate scan case is slow: the prolate cell's answer level runs meanwhile, and the campaign ends
+// with the same cases and the same Table 1 as a run without the slow case, and as one with a single worker.
+TEST(MultiFidelity, ACellTakesItsNextRoundWhileAnotherCellsCasesRun) {
+  const std::string dir = fresh_dir("multi_fidelity_cells");
+  write_file(dir + "/mf.toml", "[campaign]\nname = \"mf\"\n" + std::string(R"([[grid]]
+aspect_ratio = [2.0]
+law = ["neo-hookean"]
+capillary_number = [0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.6]
+)") + kOblateGrid + "levels = [1, 2]\ndt_check = true\n");
+  const std::string env = "FAKE_STEPS=1 FAKE_STEP_S=0.001 FAKE_LEVEL_SHIFT=0.08";
+  auto cases = [&](const std::string& db) {
+    return sql(db, "SELECT aspect_ratio, mesh_level, capillary_number, params_json FROM cases "
+                   "ORDER BY aspect_ratio, mesh_level, capillary_number, params_json");
+  };
+  auto table = [&](const std::string& db) { return sh(exe() + " query table1 --db " + db + " --format json").out; };
+  auto r = sh(campaign_cmd(env, dir + "/mf.toml", dir + "/plain.db", "--jobs 2"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  ASSERT_EQ(sql(dir + "/plain.db", "SELECT COUNT(*) FROM transitions WHERE role = 'dt_check' AND aspect_ratio = 2"),
+            "1\n") << "the prolate cell has its dt check: " << r.err;
+
+  r = sh(campaign_cmd(env + " FAKE_SLOW_CA=0.8 FAKE_SLOW_LEVEL=1 FAKE_SLOW_STEP_S=4", dir + "/mf.toml",
+                      dir + "/slow.db", "--jobs 2"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("dt/2 check on level 2, while "), std::string::npos) << r.err;
+  const std::string slow_end = sql(dir + "/slow.db", "SELECT finished_at FROM cases WHERE aspect_ratio = 0.5 AND "
+                                                     "mesh_level = 1 AND capillary_number = 0.8");
+  const std::string prolate_answers_before = sql(
+      dir + "/slow.db", "SELECT COUNT(*) FROM cases WHERE aspect_ratio = 2 AND mesh_level = 2 AND finished_at < '" +
+                            slow_end.substr(0, slow_end.size() - 1) + "'");
+  EXPECT_GT(std::stoi(prolate_answers_before), 3) << "the prolate answer level ran while the oblate scan case did";
+  EXPECT_EQ(cases(dir + "/slow.db"), cases(dir + "/plain.db"));
+  EXPECT_EQ(table(dir + "/slow.db"), table(dir + "/plain.db"));
+
+  r = sh(campaign_cmd(env, dir + "/mf.toml", dir + "/one.db", "--jobs 1"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(cases(dir + "/one.db"), cases(dir + "/plain.db"));
+  EXPECT_EQ(table(dir + "/one.db"), table(dir + "/plain.db"));
+}
+
 }  // namespace
 }  // namespace capsim::campaign::testing

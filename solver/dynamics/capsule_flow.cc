@@ -48,7 +48,7 @@ membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Ei
 
 membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q, bool warm) {
   auto t0 = std::chrono::steady_clock::now();
-  membrane::MembraneState s = mechanics_->evaluate(x);
+  membrane::MembraneState s = mechanics_->evaluate(x, /*with_energy=*/false);
   timings_.membrane_s += seconds_since(t0);
   t0 = std::chrono::steady_clock::now();
   // With bending: its evaluation factorises the mass matrix on x (its two mass solves need it), and the

@@ -69,10 +69,10 @@ class CapsuleFlow {
   /// @brief v on positions x (3 × N). Also fills q (the membrane load) when asked.
   /// @throws membrane::DegenerateSurface if x has a collapsed element (a blow-up).
   FlowEvaluation velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, Eigen::Matrix3Xd* load = nullptr);
-  /// @brief The membrane load q on positions x alone (membrane + load solve, no boundary integral): for
-  /// diagnostics that need q but not v. Not counted as a flow evaluation; its time goes to the membrane and
-  /// load phases. Returns the membrane state (tensions, elastic forces); with bending stiffness q includes
-  /// the bending load, whose energy and largest moment last_bending() holds.
+  /// @brief The membrane load q on positions x alone (membrane + load solve, no boundary integral): for diagnostics
+  /// that need q but not v. Not counted as a flow evaluation; its time goes to the membrane and load phases. Returns
+  /// the membrane state (tensions, elastic forces; not the energy, NaN); with bending stiffness q includes the bending
+  /// load, whose energy and largest moment last_bending() holds.
   /// @throws membrane::DegenerateSurface if x has a collapsed element.
   membrane::MembraneState membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q);
   /// @brief Bending energy and largest moment of the last membrane_load / velocity (zero without bending).

@@ -112,7 +112,7 @@ Invariants invariants(const Ref& r, const PointKinematics& k) {
 }
 }  // namespace
 
-MembraneState MembraneMechanics::evaluate(const Eigen::Matrix3Xd& x) const {
+MembraneState MembraneMechanics::evaluate(const Eigen::Matrix3Xd& x, bool with_energy) const {
   // Two phases, so that the result is bitwise the same for any thread count: (1) in parallel over elements,
   // each element's forces on its six nodes, energy and tension extremes into its own slot; (2) serially in
   // element order, the sums over elements. Per-call buffers keep evaluate() const and thread-safe.
@@ -133,7 +133,7 @@ MembraneState MembraneMechanics::evaluate(const Eigen::Matrix3Xd& x) const {
         break;
       }
       const Invariants inv = invariants(r, k);
-      we += r.weight0 * law_.energy(inv.I1, inv.Js);
+      if (with_energy) we += r.weight0 * law_.energy(inv.I1, inv.Js);
       const EnergyDerivatives d = law_.derivatives(inv.I1, inv.Js);
       const double tau0 = 2.0 * d.d_I1 * inv.l1 / inv.l2 + d.d_Js, tau1 = 2.0 * d.d_I1 * inv.l2 / inv.l1 + d.d_Js;
       // λ1 ≥ λ2 does not order the tensions: Skalak's τ1 − τ2 = (λ1² + λ2² − 1)(λ1/λ2 − λ2/λ1) is negative
@@ -169,10 +169,11 @@ MembraneState MembraneMechanics::evaluate(const Eigen::Matrix3Xd& x) const {
     const double* fe = force.data() + static_cast<std::size_t>(e) * 18;
     for (int a = 0; a < 6; ++a)
       for (int c = 0; c < 3; ++c) s.internal_force(c, el[a]) += fe[3 * a + c];
-    s.energy += energy[e];
+    s.energy += energy[e];  // zeros without with_energy: NaN below
     s.tau_min = std::min(s.tau_min, lo[e]);
     s.tau_max = std::max(s.tau_max, hi[e]);
   }
+  if (!with_energy) s.energy = std::numeric_limits<double>::quiet_NaN();
   return s;
 }
 

@@ -51,9 +51,12 @@ class MembraneMechanics {
   MembraneMechanics(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& reference, const MembraneLaw& law)
       : MembraneMechanics(mesh, reference, law, Options{}) {}
 
-  /// @brief Energy, internal forces and extreme tensions on positions x.
+  /// @brief Energy, internal forces and extreme tensions on positions x. Without @p with_energy the energy
+  /// is not computed (MembraneState::energy is NaN): the flow evaluations need forces and tensions only, and
+  /// the energy density (a logarithm or a power per quadrature point) was ≈ 2 % of a level-3 evaluation. The
+  /// forces and tensions are the same either way.
   /// @throws DegenerateSurface if an element is flipped or collapsed.
-  [[nodiscard]] MembraneState evaluate(const Eigen::Matrix3Xd& x) const;
+  [[nodiscard]] MembraneState evaluate(const Eigen::Matrix3Xd& x, bool with_energy = true) const;
 
   /// @brief Elastic energy W only (for finite-difference checks).
   [[nodiscard]] double energy(const Eigen::Matrix3Xd& x) const;

@@ -177,6 +177,25 @@ TEST(LoadSolver, CholmodAndConjugateGradientAgree) {
   EXPECT_NEAR(direct.mass_matrix().sum(), area_and_volume(m, x).area, 1e-12);
 }
 
+// The flow evaluations skip the energy (MembraneMechanics::evaluate's with_energy): the forces and tensions must be
+// bitwise those of the full evaluation, and the energy must not pass for a number.
+TEST(MembraneMechanics, EvaluationWithoutEnergyHasTheSameForcesAndTensions) {
+  const auto m = mesh::make_capsule_mesh(2, 0.5);
+  for (const bool skalak : {false, true}) {
+    const NeoHookeanLaw nh;
+    const SkalakLaw sk(1.0);
+    const MembraneLaw& law = skalak ? static_cast<const MembraneLaw&>(sk) : nh;
+    const MembraneMechanics mech(m, m.nodes, law);
+    const Matrix3Xd x = smooth_deformation(m.nodes, 0.3);
+    const MembraneState full = mech.evaluate(x), lean = mech.evaluate(x, false);
+    EXPECT_TRUE(full.internal_force == lean.internal_force) << (skalak ? "Skalak" : "NH");
+    EXPECT_EQ(full.tau_min, lean.tau_min);
+    EXPECT_EQ(full.tau_max, lean.tau_max);
+    EXPECT_GT(full.energy, 0.0);
+    EXPECT_TRUE(std::isnan(lean.energy));
+  }
+}
+
 // numerics.load_warm_start: CG on the correction to a guess stops at the same residual |R − M q| ≤ tol |R|
 // as a cold solve, so it gives the cold answer to the tolerance, in fewer iterations when the guess is close
 // (the previous stage's load), and the exact guess needs no more than one iteration per component.

@@ -69,27 +69,10 @@ void set_stop_test(CaseParams& p, bool stop_for_answer, unsigned need) {
     p.set("time.stop_test", std::string(name));
 }
 
-// time.dt_accuracy of a new case for answer(s) `need` with o.ca_star_dt_accuracy: that step for a Ca* edge alone,
-// else the cell's, taken from `cell` (a scan-level case: the grid's, never a per-answer step). Without the
-// option the template's.
-void set_dt_for_answer(CaseParams& p, const MultiFidelityOptions& o, unsigned need, const CaseParams& cell) {
-  if (!o.ca_star_dt_accuracy) return;
-  if (need == kMinD12) {
-    p.set("time.dt_accuracy", *o.ca_star_dt_accuracy);
-    return;
-  }
-  const auto& values = cell.values();
-  if (const auto it = values.find("time.dt_accuracy"); it != values.end())
-    p.set("time.dt_accuracy", it->second);
-  else
-    p.erase("time.dt_accuracy");
-}
-
 // Appends the cases of `proposals` (template `base`, at `level`) within the budget; false once it is spent.
-// `precision`: numerics.kernel_precision of the new cases ("": the base case's). `cell`: a scan-level case of the
-// cell (set_dt_for_answer).
+// `precision`: numerics.kernel_precision of the new cases ("": the base case's).
 bool emit(const CaseParams& base, int level, const Proposals& proposals, const MultiFidelityOptions& o,
-          std::vector<CaseParams>& out, int& budget, const CaseParams& cell, const std::string& precision = "") {
+          std::vector<CaseParams>& out, int& budget, const std::string& precision = "") {
   for (std::size_t i = 0; i < proposals.ca.size(); ++i) {
     if (budget <= 0) return false;
     CaseParams p = base;
@@ -97,7 +80,6 @@ bool emit(const CaseParams& base, int level, const Proposals& proposals, const M
     p.set("flow.capillary_number", proposals.ca[i]);
     if (!precision.empty()) p.set("numerics.kernel_precision", precision);
     set_stop_test(p, o.stop_for_answer, proposals.need[i]);
-    set_dt_for_answer(p, o, proposals.need[i], cell);
     out.push_back(std::move(p));
     --budget;
   }
@@ -161,19 +143,13 @@ bool has_dt_check(const std::vector<SampleGroup>& groups, const std::vector<std:
 }
 
 // The answer-level sample phase 5 re-runs with dt/2: the CaH-low case, else the Ca*-low case (nullptr: neither,
-// or it has no recorded step) — or the Ca*-low case where its step is the larger (ca_star_dt_accuracy): the
-// cell's coarsest step is the one to check.
+// or it has no recorded step).
 const Sample* dt_check_sample(const Transition& t, const SampleGroup& answer) {
-  auto at = [&](const std::optional<double>& ca) -> const Sample* {
-    if (!ca) return nullptr;
-    for (const auto& s : answer.samples)
-      if (same_ca(s.ca, *ca) && s.dt) return &s;
-    return nullptr;
-  };
-  const Sample* h = at(t.ca_h_low);
-  const Sample* star = at(t.ca_star_low);
-  if (h && star && *star->dt > *h->dt * (1 + 1e-9)) return star;
-  return t.ca_h_low ? h : star;
+  const std::optional<double> ca = t.ca_h_low ? t.ca_h_low : t.ca_star_low;
+  if (!ca) return nullptr;
+  for (const auto& s : answer.samples)
+    if (same_ca(s.ca, *ca) && s.dt) return &s;
+  return nullptr;
 }
 
 std::vector<double> sampled_ca(const SampleGroup& g) {
@@ -270,7 +246,7 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
           p.add(x, need_inside(ta, answer->samples, x));
       }
     }
-    if (!emit(answer ? answer->base : scan.base, answer_level, p, o, out, budget, scan.base)) break;
+    if (!emit(answer ? answer->base : scan.base, answer_level, p, o, out, budget)) break;
   }
   return out;
 }
@@ -328,8 +304,7 @@ std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups
       outwards(false, t.ca_star_below, t.ca_star_low);
       outwards(false, t.ca_star_high, t.ca_star_above);
     }
-    const SampleGroup* scan = find_group(groups, roles, answer, o.levels[0], "scan");
-    if (!emit(answer.base, o.levels[2], p, o, out, budget, scan ? scan->base : answer.base, o.check_precision)) break;
+    if (!emit(answer.base, o.levels[2], p, o, out, budget, o.check_precision)) break;
   }
   return out;
 }
@@ -355,9 +330,6 @@ std::vector<CaseParams> dt_check_cases(const std::vector<SampleGroup>& groups, c
     p.set("time.dt", 0.5 * *c->dt);
     // The same stop as the case it halves the step of: the pair then differs by the step, not by what it waited for.
     set_stop_test(p, o.stop_for_answer, need_of(c->stop_test));
-    // Its step is explicit (time.dt), so the accuracy step does not act; the cell's keeps its identity plain.
-    const SampleGroup* scan = find_group(groups, roles, answer, o.levels[0], "scan");
-    set_dt_for_answer(p, o, kBoth, scan ? scan->base : answer.base);
     out.push_back(std::move(p));
     --budget;
   }

@@ -31,7 +31,6 @@
 /// (the refinement); 6 runs last (the cheap dt check first, so that a campaign interrupted among the check
 /// level's long cases has it). The mesh part is not waited for: on a third level it costs hours.
 
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -53,10 +52,6 @@ struct MultiFidelityOptions {
   /// cases stop once min D12 repeats, CaH's once max τmin repeats, a Ca serving both waits for both; the scan
   /// level (the grid) keeps the template's. Off: every new case keeps its template's stop test.
   bool stop_for_answer = false;
-  /// @brief time.dt_accuracy of the new cases of phases 2–6 that only a Ca* edge needs (the cases stop_for_answer
-  /// would stop on min D12); every other new case gets the cell's (its scan-level case's). Unset: the template's.
-  /// With it, phase 5 halves the coarser step of each cell's two candidates (below).
-  std::optional<double> ca_star_dt_accuracy = std::nullopt;
 };
 
 /// @brief Phases 2–4: the cases of one round on the answer level (none: the answer level is done). New cases
@@ -88,10 +83,7 @@ std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups
 bool rounds_may_overlap(const MultiFidelityOptions& o, const std::vector<int>& unfinished_levels);
 
 /// @brief Phase 5: per cell, the CaH-low case of the answer level (else its Ca*-low case) with time.dt set
-/// to half the step it ran with; none in a cell that has a dt check case already (any Ca, any status). Where
-/// the Ca*-low case ran with the larger step (o.ca_star_dt_accuracy), that one: the dt/2 re-run of the cell's
-/// coarsest step bounds the time error of its finer-stepped answer too (for a second-order scheme by about
-/// its square ratio), so one re-run per cell still measures every answer's dt part, conservatively.
+/// to half the step it ran with; none in a cell that has a dt check case already (any Ca, any status).
 std::vector<CaseParams> dt_check_cases(const std::vector<SampleGroup>& groups, const MultiFidelityOptions& o,
                                        int budget);
 

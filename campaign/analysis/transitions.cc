@@ -117,12 +117,8 @@ std::string group_key(const CaseParams& params) {
     // Ca varies within a group; the kernel precision is how a case was computed, not what (both precisions
     // of a case answer the same question to ~1e-6): a check level run in mixed precision joins its group.
     // Likewise the stop test: which answer the periodic stop waited for (a multi-fidelity campaign's
-    // stop_for_answer), not the question; the answer it did not wait for carries its period spread. And the
-    // accuracy step (a multi-fidelity campaign's ca_star_dt_accuracy): how finely in time, which the cell's dt
-    // check measures (an explicit time.dt, by contrast, stays in the key: it marks the dt check's own groups).
-    if (k == "flow.capillary_number" || k == "numerics.kernel_precision" || k == "time.stop_test" ||
-        k == "time.dt_accuracy")
-      continue;
+    // stop_for_answer), not the question; the answer it did not wait for carries its period spread.
+    if (k == "flow.capillary_number" || k == "numerics.kernel_precision" || k == "time.stop_test") continue;
     auto parsed = nlohmann::json::parse(v, nullptr, false);
     j[k] = (!parsed.is_discarded() && (parsed.is_number() || parsed.is_boolean() || parsed.is_string()))
                ? parsed

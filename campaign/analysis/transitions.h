@@ -97,10 +97,8 @@ struct SampleGroup {
 };
 
 /// @brief The group key of a case: canonical JSON of its identity keys except Ca, numerics.kernel_precision
-/// (how a case was computed, not what: both precisions agree to ~1e-6 in min D12, results/speed/mixed_ab_case.json),
-/// time.stop_test (which answer its stop waited for; the other carries its period spread) and time.dt_accuracy
-/// (how finely in time; a multi-fidelity campaign's dt check measures its effect). So a campaign that puts
-/// time.dt_accuracy on a grid axis gets one group for all its values: a time-step study is scripts/step_study's.
+/// (how a case was computed, not what: both precisions agree to ~1e-6 in min D12, results/speed/mixed_ab_case.json)
+/// and time.stop_test (which answer its stop waited for; the other carries its period spread).
 std::string group_key(const CaseParams& params);
 
 /// @brief The keys in which two group keys differ, as "key (a vs b), ..." (for messages); "" if equal or

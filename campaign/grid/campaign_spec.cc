@@ -205,7 +205,7 @@ CampaignSpec parse_campaign(const std::string& text, const std::string& source) 
     if (!a->is_table()) fail(source, "[analysis]", "expected a table");
     const auto& at = *a->as_table();
     expect_only(at, {"D12_threshold", "adaptive", "ca_tolerance", "max_cases", "max_rounds", "levels", "dt_check",
-                     "check_precision", "stop_for_answer", "ca_star_dt_accuracy"},
+                     "check_precision", "stop_for_answer"},
                 source, "[analysis]");
     auto number = [&](const char* k, double& out, double lo, double hi) {
       if (auto* n = at.get(k)) {
@@ -270,18 +270,6 @@ CampaignSpec parse_campaign(const std::string& text, const std::string& source) 
     if (spec.analysis.stop_for_answer && spec.analysis.levels.empty())
       fail(source, "[analysis] stop_for_answer",
            "needs [analysis] levels (it sets the stop test of the cases the answer level adds)");
-    if (auto* n = at.get("ca_star_dt_accuracy")) {
-      std::optional<double> x = n->value_exact<double>();
-      if (!x) if (auto i = n->value_exact<std::int64_t>()) x = static_cast<double>(*i);
-      if (!x) fail(source, "[analysis] ca_star_dt_accuracy", "expected a number, got " + toml_type_name(*n));
-      if (spec.analysis.levels.empty())
-        fail(source, "[analysis] ca_star_dt_accuracy",
-             "needs [analysis] levels (it sets the step of the cases the answer level adds for a Ca* edge)");
-      // Its values are those of the case key it sets (the key registry).
-      if (const std::string why = check_case_value(*find_case_key("time.dt_accuracy"), Value{*x}); !why.empty())
-        fail(source, "[analysis] ca_star_dt_accuracy", why);
-      spec.analysis.ca_star_dt_accuracy = *x;
-    }
     if (auto* n = at.get("check_precision")) {
       auto v = n->value_exact<std::string>();
       if (!v) fail(source, "[analysis] check_precision", "expected a string, got " + toml_type_name(*n));
@@ -329,7 +317,6 @@ std::string CampaignSpec::to_json() const {
   }
   if (!analysis.check_precision.empty()) j["analysis"]["check_precision"] = analysis.check_precision;
   if (analysis.stop_for_answer) j["analysis"]["stop_for_answer"] = true;
-  if (analysis.ca_star_dt_accuracy) j["analysis"]["ca_star_dt_accuracy"] = *analysis.ca_star_dt_accuracy;
   return j.dump();
 }
 

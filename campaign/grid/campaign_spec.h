@@ -2,7 +2,6 @@
 /// @file
 /// @brief A campaign file (TOML) parsed and validated strictly; see schemas/campaign_keys.md.
 
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,12 +43,6 @@ struct AnalysisSpec {
   /// switched on for a campaign that has run, it changes only the cases added afterwards (a Ca that exists is
   /// not proposed again, whatever its stop test).
   bool stop_for_answer = false;
-  /// @brief time.dt_accuracy of the cases the answer and check levels add for a Ca* edge alone (unset: the
-  /// template's, as every other case). min D12 tolerates a larger step than max τmin (results/time_steps/
-  /// whole_cases: at 0.04 min D12 moves by ≤ 1e-3, a third of its level 3 → 4 change or less, while max τmin
-  /// moved by 4× its level 3 → 4 change in one cell), and the stages grow as dt^½, so such a case needs ≈ 1.5×
-  /// fewer flow evaluations. The dt check then halves the coarsest step of each cell (analysis/multi_fidelity.h).
-  std::optional<double> ca_star_dt_accuracy = std::nullopt;
 };
 
 /// @brief A validated campaign.

@@ -353,8 +353,7 @@ int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& 
     // The phases of analysis/multi_fidelity.h, the first that has something to add.
     const auto& lv = spec.analysis.levels;
     const MultiFidelityOptions mf{lv, spec.analysis.d12_threshold, spec.analysis.ca_tolerance, spec.analysis.adaptive,
-                                  spec.analysis.dt_check, spec.analysis.check_precision, spec.analysis.stop_for_answer,
-                                  spec.analysis.ca_star_dt_accuracy};
+                                  spec.analysis.dt_check, spec.analysis.check_precision, spec.analysis.stop_for_answer};
     // A top-up while cases run or wait (Runner::set_top_up): the same phases for every cell once only check-level
     // cases are left (rounds_may_overlap); before that, for the cells none of whose cases runs or waits. A cell's
     // phases read only its own cases, so it takes the round it would take after a global barrier, only sooner:

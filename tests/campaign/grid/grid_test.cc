@@ -245,17 +245,6 @@ TEST(Grid, MultiFidelityLevelsSetTheScanLevel) {
   EXPECT_EQ(spec.to_json().find("stop_for_answer"), std::string::npos) << "stored only when set";
   bad(head + "stop_for_answer = true\n", "needs [analysis] levels");
   bad(head + "levels = [2, 3]\nstop_for_answer = 'yes'\n", "expected true or false");
-  // ca_star_dt_accuracy: the accuracy step of the Ca*-only cases, within time.dt_accuracy's range.
-  const auto step = parse_campaign(head + "levels = [2, 3]\nca_star_dt_accuracy = 0.04\n", "mf.toml");
-  ASSERT_TRUE(step.analysis.ca_star_dt_accuracy);
-  EXPECT_DOUBLE_EQ(*step.analysis.ca_star_dt_accuracy, 0.04);
-  EXPECT_FALSE(spec.analysis.ca_star_dt_accuracy) << "unset by default";
-  EXPECT_NE(step.to_json().find("\"ca_star_dt_accuracy\":0.04"), std::string::npos) << step.to_json();
-  EXPECT_EQ(spec.to_json().find("ca_star_dt_accuracy"), std::string::npos) << "stored only when set";
-  bad(head + "ca_star_dt_accuracy = 0.04\n", "needs [analysis] levels");
-  bad(head + "levels = [2, 3]\nca_star_dt_accuracy = 'big'\n", "expected a number");
-  bad(head + "levels = [2, 3]\nca_star_dt_accuracy = 2.0\n", "must be in (0, 1]");
-  bad(head + "levels = [2, 3]\nca_star_dt_accuracy = 0\n", "must be in (0, 1]");
   bad("[campaign]\nname='mf'\n[defaults]\nmesh.level = 3\n[[grid]]\ncapillary_number=[0.1]\n[analysis]\nlevels = [2, 3]\n",
       "[defaults] mesh.level");
   bad("[campaign]\nname='mf'\n[[grid]]\ncapillary_number=[0.1]\nmesh_level=[2]\n[analysis]\nlevels = [2, 3]\n",

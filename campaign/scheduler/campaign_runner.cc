@@ -92,6 +92,9 @@ class Runner {
   /// many cases it added to the campaign (refine_campaign's top-up). New cases join the queue in --order.
   using TopUp = std::function<int(const std::vector<CaseParams>& unfinished)>;
   void set_top_up(TopUp top_up) { top_up_ = std::move(top_up); }
+  /// Queue the coarser mesh levels first (then --order within a level): in a multi-fidelity campaign a
+  /// scan case gates its cell's whole answer level, so it must not wait behind another cell's answer cases.
+  void set_coarse_levels_first(bool on) { coarse_levels_first_ = on; }
 
   /// Runs every queued case of the campaign (and what the top-up adds meanwhile); returns false if stopped
   /// by a signal.
@@ -192,6 +195,10 @@ class Runner {
       std::stable_sort(pending.begin(), pending.end(),
                        [&](const CaseRow& a, const CaseRow& b) { return longest ? longer(a, b) : longer(b, a); });
     }
+    if (coarse_levels_first_)
+      std::stable_sort(pending.begin(), pending.end(), [](const CaseRow& a, const CaseRow& b) {
+        return a.params.mesh_level() < b.params.mesh_level();
+      });
     std::reverse(pending.begin(), pending.end());  // pop_back = next case
   }
 
@@ -286,6 +293,7 @@ class Runner {
   int total_ = 0, finished_ = 0, failed_ = 0, queued_ = 0;
   EtaModel eta_;  // per mesh level, wall seconds against estimated cost of the campaign's finished cases
   TopUp top_up_;  // empty: the queue is all there is until run_queued returns
+  bool coarse_levels_first_ = false;
 };
 
 /// After a manager crash: stop leftover workers, then ingest finished results or requeue.
@@ -344,7 +352,8 @@ bool reanalyse_campaign(Store& store, std::int64_t campaign_id) {
 }
 
 int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& spec, const std::string& runs_dir,
-                    std::string* what, const std::vector<CaseParams>* unfinished, std::map<std::string, int>* cell_rounds) {
+                    std::string* what, const std::vector<CaseParams>* unfinished,
+                    std::map<std::string, int>* cell_rounds) {
   const int budget = spec.analysis.max_cases - store.count_campaign_cases(campaign_id, "adaptive");
   auto groups = group_cases(store.campaign_samples(campaign_id));
   std::vector<CaseParams> add;
@@ -578,9 +587,9 @@ int run_campaign(const RunOptions& opt, const BeforeRun& before_run) {
   runner.message("capsim campaign: '" + spec.name + "': " + std::to_string(cases.size()) + " grid cases, " +
                  std::to_string(jobs) + " job(s) x " + std::to_string(threads) + " thread(s), database " + opt.db_path);
 
-  // Multi-fidelity: max_rounds answer-level rounds, then the check level and the dt check (two more). A round
-  // that tops up the queue while check-level cases run counts like any other.
-  const int rounds = spec.analysis.max_rounds + (spec.analysis.levels.empty() ? 0 : 2);
+  // Plain adaptive mode: at most max_rounds rounds. Multi-fidelity: max_rounds answer-level rounds and two more
+  // (the dt check, the check level) per cell, counted in cell_rounds below; rounds_done only numbers the messages.
+  const int rounds = spec.analysis.max_rounds;
   int rounds_done = 0;
   // Multi-fidelity: a free worker asks for the next round's cases instead of waiting for the round to end —
   // of the cells none of whose cases runs or waits, or of every cell once only check-level cases are left
@@ -588,6 +597,10 @@ int run_campaign(const RunOptions& opt, const BeforeRun& before_run) {
   // the queue in --order as soon as its own cases are done. The round limit is then per cell (cell_rounds).
   std::map<std::string, int> cell_rounds;
   const bool multi_fidelity = !spec.analysis.levels.empty();
+  // Cells run ahead of each other, so a cell's scan case must not queue behind another cell's answer-level cases:
+  // the coarser levels first (the main command's first run without this left one core idle for the last 128 s,
+  // the two Skalak cells' answer levels having started last).
+  runner.set_coarse_levels_first(multi_fidelity);
   if (multi_fidelity)
     runner.set_top_up([&](const std::vector<CaseParams>& unfinished) {
       std::string what;

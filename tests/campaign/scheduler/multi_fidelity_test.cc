@@ -236,6 +236,11 @@ capillary_number = [0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.6]
 
   r = sh(campaign_cmd(env, dir + "/mf.toml", dir + "/one.db", "--jobs 1"));
   ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find(", while "), std::string::npos) << "a cell went ahead while the other's scan waited: " << r.err;
+  // The coarser levels first: a scan case gates its cell's answer level, so none waits behind answer cases.
+  const std::string levels = sql(dir + "/one.db", "SELECT c.mesh_level FROM attempts a JOIN cases c USING(case_id) "
+                                                  "ORDER BY a.attempt_id");
+  EXPECT_EQ(levels.find('1', levels.find('2')), std::string::npos) << levels;
   EXPECT_EQ(cases(dir + "/one.db"), cases(dir + "/plain.db"));
   EXPECT_EQ(table(dir + "/one.db"), table(dir + "/plain.db"));
 }

@@ -598,8 +598,8 @@ int run_campaign(const RunOptions& opt, const BeforeRun& before_run) {
   std::map<std::string, int> cell_rounds;
   const bool multi_fidelity = !spec.analysis.levels.empty();
   // Cells run ahead of each other, so a cell's scan case must not queue behind another cell's answer-level cases:
-  // the coarser levels first (the main command's first run without this left one core idle for the last 128 s,
-  // the two Skalak cells' answer levels having started last).
+  // the coarser levels first. (It did not shorten the main command's idle tail, which is the last cell's chain
+  // of dependent rounds: results/main_command_15min/README.md.)
   runner.set_coarse_levels_first(multi_fidelity);
   if (multi_fidelity)
     runner.set_top_up([&](const std::vector<CaseParams>& unfinished) {

@@ -96,6 +96,9 @@ class CapsuleFlow {
   void begin_step() { load_guess_ = false; }
 
  private:
+  // membrane_load, with the load solve started from q's values when `warm` (LoadSolver::solve).
+  membrane::MembraneState membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q, bool warm);
+
   double Ca_;
   std::unique_ptr<mesh::SurfaceMesh> mesh_;
   std::unique_ptr<membrane::MembraneLaw> law_;
@@ -110,7 +113,6 @@ class CapsuleFlow {
   FlowTimings timings_;
   bool background_flow_ = true;
   bool volume_correction_ = true;
-  membrane::MembraneState membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q, bool warm);
   // Rule of the flux integral: shape functions and derivatives at its points, weights · ½.
   mesh::P2Tabulation flux_rule_;  // degree-6 rule of the volume-flux integral
   Eigen::Matrix3Xd normals_;

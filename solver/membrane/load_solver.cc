@@ -112,8 +112,8 @@ void LoadSolver::factorize() {
 
 
 void LoadSolver::solve(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, bool warm) {
-  const Eigen::MatrixX3d rhs = R.transpose();
   if (options_.backend == Backend::Cholmod) {
+    const Eigen::MatrixX3d rhs = R.transpose();  // CHOLMOD's layout (one column per component); CG reads R itself
     q = impl_->cholmod.solve(rhs).transpose();
     last_iterations_ = 0;
     // CHOLMOD's positive-definiteness test lets a NaN matrix through (NaN pivots compare false).

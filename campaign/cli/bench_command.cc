@@ -147,6 +147,7 @@ int bench_flow(const BenchArgs& ba) {
                         {"targets", s.targets},
                         {"sources", s.sources},
                         {"used_symmetry", s.used_symmetry},
+                        {"used_central", s.used_central},
                         {"repeat", s.repeat},
                         {"evaluation_ms", s.evaluation_ms},
                         {"evaluation_double_ms", s.evaluation_double_ms},

@@ -139,6 +139,10 @@ class CaseRun {
     // kept exactly so after each step (mesh::symmetrise says why); a resumed run decides the same way from
     // its checkpoint, which holds a symmetrised state.
     keep_mirror_ = mesh::is_mirror_symmetric(mesh(), x_, 1e-12);
+    // With numerics.central_symmetry the point symmetry x → −x too (the flow's boundary integral then
+    // evaluates one node of each orbit). The reference spheroid has it to round-off only (its nodes at
+    // θ and π − θ are mapped separately), hence the tolerance; the first step's symmetrisation makes it exact.
+    keep_central_ = config_.central_symmetry && mesh::is_centrally_symmetric(mesh(), x_, 1e-12);
     before_ = x_;
     record_ = diagnostics::measure_step(mesh(), x_, t_, p_node_, 0.0);
     first_step_ = step_;
@@ -185,7 +189,10 @@ class CaseRun {
     try {
       flow_->begin_step();  // no load carried into a step: a resumed run repeats this one bitwise
       info = integrator_->step(*flow_, next_, dt_, snapshot_due ? &start_ : nullptr);
-      if (keep_mirror_) mesh::symmetrise(mesh(), next_);
+      if (keep_central_)
+        mesh::symmetrise(mesh(), next_, keep_mirror_, true);
+      else if (keep_mirror_)
+        mesh::symmetrise(mesh(), next_);
       stepped = true;
     } catch (const membrane::DegenerateSurface& e) {
       failure = e.what();
@@ -390,6 +397,7 @@ class CaseRun {
   diagnostics::TimeSeries series_;
   int p_node_ = 0;
   bool keep_mirror_ = false;  // the state started mirror-symmetric: keep it exactly so (restore_or_start)
+  bool keep_central_ = false;  // numerics.central_symmetry and a centrally symmetric start: keep that too
   diagnostics::WrinkleIndicators wrinkle_max_;  // largest sampled values over the run
 
   // The march.

@@ -35,6 +35,7 @@ CapsuleFlow::CapsuleFlow(const config::CaseConfig& c) : Ca_(c.capillary_number) 
   so.far_degree = c.far_degree;
   so.far_radius = c.far_radius;
   so.precision = c.kernel_precision == "mixed" ? stokes::KernelPrecision::Mixed : stokes::KernelPrecision::Double;
+  so.central_symmetry = c.central_symmetry;
   single_layer_ = std::make_unique<stokes::SingleLayer>(*mesh_, so);
   volume_correction_ = c.volume_correction;
   flux_rule_ = mesh::P2Tabulation::of_degree(6);
@@ -87,6 +88,7 @@ FlowEvaluation CapsuleFlow::velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd
   timings_.stokes_s += seconds_since(t0);
   const stokes::SingleLayerStats& st = single_layer_->last_stats();
   out.used_symmetry = st.used_symmetry;
+  out.used_central = st.used_central;
   timings_.layout_s += st.build_s;
   timings_.regular_s += st.regular_s;
   timings_.far_s += st.far_s;

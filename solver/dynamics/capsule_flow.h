@@ -35,6 +35,7 @@ struct FlowEvaluation {
   double tau_max = 0.0;         ///< largest principal tension on x
   double max_speed = 0.0;       ///< max |v − v∞| over the nodes
   bool used_symmetry = false;   ///< whether the boundary integral used the mirror symmetry
+  bool used_central = false;    ///< whether it used the point symmetry x → −x (numerics.central_symmetry)
   double volume_flux = 0.0;     ///< ∫ v·n dS of the uncorrected discrete velocity (0 for the exact flow)
   double bending_energy = 0.0;  ///< W_b on x (0 without bending stiffness)
   double max_bending_moment = 0.0;  ///< max κ_b |c − c0| on x (solver/membrane/bending.h)

@@ -38,6 +38,19 @@ Eigen::Matrix3Xd deformed(const Eigen::Matrix3Xd& ref, bool symmetric) {
   return x;
 }
 
+// A smooth deformation of the reference that is odd under x → −x as well as symmetric under x3 → −x3 (the
+// "central" scene: numerics.central_symmetry evaluates a quarter of the targets, as in a study case with it).
+Eigen::Matrix3Xd deformed_centrally_symmetric(const Eigen::Matrix3Xd& ref) {
+  Eigen::Matrix3Xd x = ref;
+  for (int i = 0; i < x.cols(); ++i) {
+    const double x1 = ref(0, i), x2 = ref(1, i), x3 = ref(2, i);
+    x(0, i) = x1 * (1.0 + 0.08 * std::sin(1.3 * x1 * x2 + 0.4 * x3 * x3));
+    x(1, i) = x2 + 0.05 * std::sin(x1) + 0.03 * x1 * x3 * x3;
+    x(2, i) = x3 * (1.0 - 0.04 * x1 * x2);
+  }
+  return x;
+}
+
 // `in_double`: the same case in double precision, timed alternately too (nullptr: the evaluation is double).
 FlowBenchScene measure_scene(CapsuleFlow& flow, CapsuleFlow* in_double, const Eigen::Matrix3Xd& x,
                              const std::string& name, int repeat) {
@@ -48,6 +61,7 @@ FlowBenchScene measure_scene(CapsuleFlow& flow, CapsuleFlow* in_double, const Ei
   const FlowEvaluation ev = flow.velocity(x, v, &q);  // warm-up: first-touch allocation, and q for the bare sum
   stokes::SingleLayer& op = flow.single_layer();
   sc.used_symmetry = ev.used_symmetry;
+  sc.used_central = ev.used_central;
 
   // The bare regular sum: the same targets (the ones the evaluation chose) and the same sources, copied so
   // that the evaluations in between cannot touch them.
@@ -163,6 +177,17 @@ FlowBenchReport bench_flow(const FlowBenchOptions& options) {
   for (const bool symmetric : {true, false})
     report.scenes.push_back(measure_scene(flow, in_double.get(), deformed(flow.reference(), symmetric),
                                           symmetric ? "symmetric" : "general", repeat));
+  // The same capsule with numerics.central_symmetry, on a scene that has both symmetries.
+  config::CaseConfig cc = c;
+  cc.central_symmetry = true;
+  CapsuleFlow central(cc);
+  std::unique_ptr<CapsuleFlow> central_double;
+  if (in_double) {
+    cc.kernel_precision = "double";
+    central_double = std::make_unique<CapsuleFlow>(cc);
+  }
+  report.scenes.push_back(measure_scene(central, central_double.get(), deformed_centrally_symmetric(central.reference()),
+                                        "central", repeat));
   return report;
 }
 

@@ -13,7 +13,8 @@
 ///
 /// Two scenes, both the a/b = 2 Skalak capsule at Ca = 0.3 with a smooth deformation: "symmetric" keeps the
 /// x3 → −x3 mirror symmetry (the boundary integral evaluates half the targets, as in every run that starts
-/// in the shear plane), "general" breaks it (all targets).
+/// in the shear plane), "general" breaks it (all targets); "central" has both the mirror and the point symmetry
+/// x → −x and is evaluated with numerics.central_symmetry (a quarter of the targets).
 
 #include <string>
 #include <vector>
@@ -39,11 +40,12 @@ struct FlowBenchOptions {
 
 /// @brief One scene's measurement. Times are milliseconds per evaluation.
 struct FlowBenchScene {
-  std::string name;             ///< "symmetric" or "general"
+  std::string name;             ///< "symmetric", "general" or "central"
   int nodes = 0;                ///< mesh nodes N
   int targets = 0;              ///< targets the boundary integral evaluated (N, or about N/2 with symmetry)
   int sources = 0;              ///< regular quadrature points (unpadded)
   bool used_symmetry = false;   ///< whether the evaluation used the mirror symmetry
+  bool used_central = false;    ///< whether it used the point symmetry x → −x too
   int repeat = 0;               ///< timed evaluations (and as many bare sums)
   double evaluation_ms = 0.0;   ///< median wall time of CapsuleFlow::velocity
   double evaluation_double_ms = 0.0;  ///< the same in double precision (only with kernel_precision "mixed"; else 0)

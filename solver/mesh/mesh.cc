@@ -94,6 +94,19 @@ void build_mirror(SurfaceMesh& m) {
   }
 }
 
+void build_central(SurfaceMesh& m) {
+  // The icosahedron and the normalised mid-points are sign-symmetric, so images are bitwise negated.
+  std::map<std::array<double, 3>, int> where;
+  for (int i = 0; i < m.num_nodes(); ++i) where[{m.nodes(0, i), m.nodes(1, i), m.nodes(2, i)}] = i;
+  m.central_node.assign(m.num_nodes(), -1);
+  const auto neg = [](double v) { return v == 0.0 ? 0.0 : -v; };
+  for (int i = 0; i < m.num_nodes(); ++i) {
+    auto it = where.find({neg(m.nodes(0, i)), neg(m.nodes(1, i)), neg(m.nodes(2, i))});
+    if (it == where.end() || it->second == i) throw std::logic_error("mesh: node without image under x -> -x");
+    m.central_node[i] = it->second;
+  }
+}
+
 // Meridian speed of the spheroid, ds/dθ' = sqrt(a² sin²θ' + b² cos²θ').
 double meridian_speed(double a, double b, double t) {
   const double s = std::sin(t), c = std::cos(t);
@@ -180,6 +193,7 @@ SurfaceMesh make_sphere_mesh(int level) {
   std::fill(m.kind.begin(), m.kind.begin() + static_cast<long>(s.v.size()), NodeKind::Vertex);
   build_adjacency(m);
   build_mirror(m);
+  build_central(m);
   return m;
 }
 
@@ -277,18 +291,51 @@ bool is_mirror_symmetric(const SurfaceMesh& m, const Eigen::Matrix3Xd& x, double
   return true;
 }
 
-void symmetrise(const SurfaceMesh& m, Eigen::Matrix3Xd& x) {
+bool is_centrally_symmetric(const SurfaceMesh& m, const Eigen::Matrix3Xd& x, double tol) {
+  if (static_cast<int>(m.central_node.size()) != x.cols() || x.cols() == 0) return false;
+  const double scale = tol * (x.rowwise().maxCoeff() - x.rowwise().minCoeff()).norm();
   for (int i = 0; i < x.cols(); ++i) {
-    const int j = m.mirror_node[i];
-    if (j == i) {
-      x(2, i) = 0.0;
-    } else if (i < j) {
-      const double a = 0.5 * (x(0, i) + x(0, j)), b = 0.5 * (x(1, i) + x(1, j)), c = 0.5 * (x(2, i) - x(2, j));
-      x(0, i) = x(0, j) = a;
-      x(1, i) = x(1, j) = b;
-      x(2, i) = c;
-      x(2, j) = -c;
-    }
+    const int j = m.central_node[i];
+    const double e = std::abs(x(0, i) + x(0, j)) + std::abs(x(1, i) + x(1, j)) + std::abs(x(2, i) + x(2, j));
+    if (!(e <= scale)) return false;
+  }
+  return true;
+}
+
+void symmetrise(const SurfaceMesh& m, Eigen::Matrix3Xd& x, bool mirror, bool central) {
+  const int n = static_cast<int>(x.cols());
+  mirror = mirror && static_cast<int>(m.mirror_node.size()) == n;
+  central = central && static_cast<int>(m.central_node.size()) == n;
+  if (!mirror && !central) return;
+  // The group elements as sign patterns: identity, mirror M, point reflection P, half-turn R = M P.
+  using Signs = std::array<double, 3>;
+  constexpr Signs kM{1.0, 1.0, -1.0}, kP{-1.0, -1.0, -1.0}, kR{-1.0, -1.0, 1.0};
+  const auto image = [&](const Signs& g, int j) {
+    return Eigen::Vector3d(g[0] * x(0, j), g[1] * x(1, j), g[2] * x(2, j));
+  };
+  for (int i = 0; i < n; ++i) {
+    const int mi = mirror ? m.mirror_node[i] : i;
+    const int pi = central ? m.central_node[i] : i;
+    const int ri = mirror && central ? m.mirror_node[pi] : i;
+    if (std::min({mi, pi, ri}) < i) continue;  // the orbit is written from its smallest index
+    // Pairs first, so a member fixed by a group element (on the plane, on the x3 axis) cancels exactly:
+    // (x + g x) is bitwise g-invariant, and so is the sum of two such pairs.
+    Eigen::Vector3d mean;
+    if (mirror && central)
+      mean = ((x.col(i) + image(kM, mi)) + (image(kP, pi) + image(kR, ri))) * 0.25;
+    else if (mirror)
+      mean = 0.5 * (x.col(i) + image(kM, mi));
+    else
+      mean = 0.5 * (x.col(i) + image(kP, pi));
+    // Images before the node itself: where a member is fixed by a group element, the value written last is
+    // the mean (the images differ from it at most in the sign of a zero).
+    const auto put = [&](const Signs& g, int j) {
+      for (int k = 0; k < 3; ++k) x(k, j) = g[k] * mean[k];
+    };
+    if (mirror && central) put(kR, ri);
+    if (central) put(kP, pi);
+    if (mirror) put(kM, mi);
+    x.col(i) = mean;
   }
 }
 

@@ -158,6 +158,7 @@ void SingleLayer::copy_connectivity(const mesh::SurfaceMesh& mesh) {
     }
   }
   if (static_cast<int>(mesh.mirror_node.size()) == num_nodes_) mirror_ = mesh.mirror_node;
+  if (static_cast<int>(mesh.central_node.size()) == num_nodes_) central_ = mesh.central_node;
   // Targets in the order of their first element: the mesh's elements come from recursive subdivision
   // (children of one parent are consecutive), so this order is spatially coherent and consecutive targets
   // of the correction loops read the same neighbouring elements from cache. Each target's own sums do not
@@ -186,17 +187,34 @@ bool SingleLayer::is_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd
   return true;
 }
 
+bool SingleLayer::is_centrally_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) const {
+  if (central_.empty() || x.cols() != num_nodes_ || q.cols() != num_nodes_) return false;
+  const double lx = (x.rowwise().maxCoeff() - x.rowwise().minCoeff()).norm();
+  const double lq = q.colwise().norm().maxCoeff();
+  const double tx = opt_.symmetry_tol * lx, tq = opt_.load_symmetry_tol * lq;
+  for (int i = 0; i < num_nodes_; ++i) {
+    const int p = central_[i];
+    const double ex = std::abs(x(0, p) + x(0, i)) + std::abs(x(1, p) + x(1, i)) + std::abs(x(2, p) + x(2, i));
+    const double eq = std::abs(q(0, p) + q(0, i)) + std::abs(q(1, p) + q(1, i)) + std::abs(q(2, p) + q(2, i));
+    if (!(ex <= tx) || !(eq <= tq)) return false;  // also false for NaN
+  }
+  return true;
+}
+
 kernel::Sources SingleLayer::build_sources(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) {
   layout_points(regular_, elements_, x, q, kernel::simd_width(), sources_);
   return sources_.sources();
 }
 
-void SingleLayer::select_targets(const Eigen::Matrix3Xd& x, bool symmetric) {
+void SingleLayer::select_targets(const Eigen::Matrix3Xd& x, bool symmetric, bool central) {
   // All nodes, or one of each mirror pair (the one with the larger x3; a node on the plane is its own
-  // image and is evaluated).
+  // image and is evaluated), or with the central symmetry one of each orbit (its smallest index).
   target_ids_.clear();
   for (const int i : node_order_) {
-    if (symmetric) {
+    if (central) {
+      const int p = central_[i], m = symmetric ? mirror_[i] : i, r = symmetric ? mirror_[p] : i;
+      if (std::min({m, p, r}) < i) continue;
+    } else if (symmetric) {
       const int m = mirror_[i];
       const bool mine = m == i || x(2, i) > x(2, m) || (x(2, i) == x(2, m) && i < m);
       if (!mine) continue;
@@ -373,6 +391,23 @@ void SingleLayer::mirror(Eigen::Matrix3Xd& u) const {
   }
 }
 
+void SingleLayer::expand_central(Eigen::Matrix3Xd& u, bool symmetric) const {
+  // u(−x0) = −u(x0), and with the mirror M u(M x0) = M u(x0), so on the half-turn R = M P about x3
+  // u(R x0) = R u(x0). A node fixed by M (on the plane) or by R (on the x3 axis) gets the components the
+  // symmetry sets to zero set exactly: the sums give them as round-off in double and ≈ 1e-7 |u| in mixed
+  // precision, which would move such a node off its plane or axis and lose the symmetry (see mirror()).
+  for (const int i : target_ids_) {
+    const int p = central_[i], m = symmetric ? mirror_[i] : i, r = symmetric ? mirror_[p] : i;
+    if (symmetric && m == i) u(2, i) = 0.0;
+    if (symmetric && r == i) u(0, i) = u(1, i) = 0.0;
+    const double a = u(0, i), b = u(1, i), c = u(2, i);
+    if (symmetric) u(0, r) = -a, u(1, r) = -b, u(2, r) = c;
+    u(0, p) = -a, u(1, p) = -b, u(2, p) = -c;
+    if (symmetric) u(0, m) = a, u(1, m) = b, u(2, m) = -c;
+    u(0, i) = a, u(1, i) = b, u(2, i) = c;  // last: a member that is its own image keeps its value
+  }
+}
+
 void SingleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Eigen::Matrix3Xd& u) {
   if (x.cols() != num_nodes_ || q.cols() != num_nodes_)
     throw std::invalid_argument("stokes: x and q must have " + std::to_string(num_nodes_) + " columns (got " +
@@ -384,6 +419,7 @@ void SingleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Ei
     if (!sym && opt_.symmetry == Symmetry::On)
       throw std::invalid_argument("stokes: symmetry forced on but the scene is not symmetric under x3 -> -x3");
   }
+  const bool central = opt_.central_symmetry && opt_.symmetry != Symmetry::Off && is_centrally_symmetric(x, q);
   // 1. Layout: with the far-field tier the all-pairs sum runs over the coarse rule, else the regular rule.
   const bool far = opt_.far_degree > 0;
   layout_points(far ? coarse_ : regular_, elements_, x, q, kernel::simd_width(), sources_);
@@ -393,7 +429,7 @@ void SingleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Ei
   regular_slot_ = nullptr;
   const double t1 = now_s();
   // 2. Regular part, for the targets of this call.
-  select_targets(x, sym);
+  select_targets(x, sym, central);
   regular_sum(sources_.sources(), u);
   const double t2 = now_s();
   // 3. Far-field tier.
@@ -403,11 +439,15 @@ void SingleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Ei
   singular_correction(x, q);
   const double t3 = now_s();
   near_correction(u);
-  // 5. Mirror.
-  if (sym) mirror(u);
+  // 5. Symmetries: u at the nodes not evaluated.
+  if (central)
+    expand_central(u, sym);
+  else if (sym)
+    mirror(u);
   const double t4 = now_s();
 
   stats_.used_symmetry = sym;
+  stats_.used_central = central;
   stats_.targets = static_cast<int>(target_ids_.size());
   stats_.sources = num_elements() * static_cast<int>(far ? coarse_.size() : regular_.size());
   stats_.mid_elements = mids;

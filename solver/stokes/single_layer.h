@@ -31,6 +31,12 @@
 ///     the looser load_symmetry_tol, see SingleLayerOptions), only the targets
 ///     with x3 ≥ 0 are evaluated and u is mirrored to the others (u3 flips sign). Otherwise every target is
 ///     evaluated. Options::symmetry forces either way.
+///     Central symmetry x → −x (Options::central_symmetry, off by default): if positions and loads are also
+///     antisymmetric under mesh.central_node (x_P(i) = −x_i, q_P(i) = −q_i, to the same tolerances), only one
+///     node of each orbit of the group {identity, mirror, x → −x, half-turn about x3} is evaluated (its
+///     smallest index; of each pair {i, P(i)} without the mirror), and u(−x0) = −u(x0) fills the rest; a node
+///     fixed by a group element gets exactly what the symmetry prescribes (u3 = 0 on the mirror plane,
+///     u1 = u2 = 0 on the x3 axis). Half the targets of the mirror alone, so half the cost of phases 2 and 4.
 ///
 /// Contract:
 ///  - Cached from the constructor (depends only on connectivity and Options): element → nodes, node →
@@ -100,6 +106,11 @@ struct SingleLayerOptions {
   int far_degree = 0;
   double far_radius = 4.0;     ///< far when |x0 − c_e| > far_radius · ρ_e; finite and > 1 (ignored when off)
   Symmetry symmetry = Symmetry::Auto;
+  /// Also use the point reflection x → −x when the scene has it (numerics.central_symmetry; see the file
+  /// comment). Off by default so that the operator of an existing case stays bit for bit what it was: the
+  /// images get −u exactly where the full sum gives −u to round-off (1e-7 of |u| in mixed precision).
+  /// Ignored with Symmetry::Off.
+  bool central_symmetry = false;
   double symmetry_tol = 1e-10; ///< relative tolerance of the symmetry check on the positions (≥ 0)
   /// Relative tolerance of the symmetry check on the load (≥ 0), |q_i − P q_mirror(i)| ≤ tol · max |q|. Looser
   /// than the positions' on purpose: the load is a function of the positions (membrane law, bending, mass
@@ -121,7 +132,8 @@ struct SingleLayerOptions {
 
 /// @brief Timing and size of the last apply() (seconds).
 struct SingleLayerStats {
-  bool used_symmetry = false;  ///< whether only half of the targets were evaluated
+  bool used_symmetry = false;  ///< whether the mirror symmetry was used
+  bool used_central = false;   ///< whether the central symmetry was used (a quarter of the targets with both)
   int targets = 0;             ///< number of targets evaluated
   int sources = 0;             ///< quadrature points of the all-pairs sum (unpadded; coarse rule if far on)
   double build_s = 0.0;        ///< symmetry check and laying out the regular and near-rule points (SoA)
@@ -146,9 +158,12 @@ class SingleLayer {
 
   /// @brief Whether (x, q) is mirror-symmetric under x3 → −x3 to the tolerance (the check apply() uses).
   [[nodiscard]] bool is_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) const;
+  /// @brief Whether (x, q) is antisymmetric under x → −x (mesh.central_node) to the same tolerances.
+  [[nodiscard]] bool is_centrally_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) const;
 
   [[nodiscard]] const SingleLayerStats& last_stats() const { return stats_; }
-  /// @brief The nodes the last apply() evaluated (all, or one of each mirror pair), in evaluation order.
+  /// @brief The nodes the last apply() evaluated (all, or one of each orbit of the symmetries used), in
+  /// evaluation order.
   [[nodiscard]] const std::vector<int>& last_targets() const { return target_ids_; }
   [[nodiscard]] const SingleLayerOptions& options() const { return opt_; }
   [[nodiscard]] int num_nodes() const { return num_nodes_; }
@@ -164,7 +179,7 @@ class SingleLayer {
   // Constructor phase: connectivity copied from the mesh (checked), node → (element, local index).
   void copy_connectivity(const mesh::SurfaceMesh& mesh);
   // apply() phases (see the file comment).
-  void select_targets(const Eigen::Matrix3Xd& x, bool symmetric);
+  void select_targets(const Eigen::Matrix3Xd& x, bool symmetric, bool central);
   void regular_sum(const kernel::Sources& src, Eigen::Matrix3Xd& u);
   long long far_field(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Eigen::Matrix3Xd& u);
   // The two corrections accumulate per target into ux_, uy_, uz_ (free after regular_sum), and the near
@@ -172,6 +187,8 @@ class SingleLayer {
   void singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q);
   void near_correction(Eigen::Matrix3Xd& u);
   void mirror(Eigen::Matrix3Xd& u) const;
+  // With the central symmetry: u at every member of each evaluated orbit (mirror too when `symmetric`).
+  void expand_central(Eigen::Matrix3Xd& u, bool symmetric) const;
   // Whether float pair terms are in use (KernelPrecision::Mixed with the fast kernel): the regular sum and the
   // Duffy terms in float, u3 = 0 set on the mirror plane.
   [[nodiscard]] bool uses_mixed_precision() const {
@@ -185,6 +202,7 @@ class SingleLayer {
   std::vector<int> node_offsets_;           // node → incidences CSR
   std::vector<int> inc_element_, inc_local_;
   std::vector<int> mirror_;                 // empty if the mesh has none
+  std::vector<int> central_;                // image under x → −x; empty if the mesh has none
   std::vector<int> node_order_;             // nodes in the order targets are evaluated (spatially coherent)
   std::vector<mesh::P2Point> regular_;      // rule points
   PointTable duffy_[6];                     // Duffy rule per local node position (SoA)

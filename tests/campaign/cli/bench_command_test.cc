@@ -13,7 +13,7 @@
 namespace capsim::campaign::testing {
 namespace {
 
-TEST(BenchFlow, JsonHasTheRatiosAndPhasesOfBothScenes) {
+TEST(BenchFlow, JsonHasTheRatiosAndPhasesOfEveryScene) {
   const CmdResult r = sh(exe() + " bench flow --level 1 --threads 1 --repeat 3 --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
@@ -22,15 +22,21 @@ TEST(BenchFlow, JsonHasTheRatiosAndPhasesOfBothScenes) {
   EXPECT_EQ(j["level"], 1);
   EXPECT_EQ(j["nodes"], 162);
   EXPECT_EQ(j["threads"], 1);
-  ASSERT_EQ(j["scenes"].size(), 2u);
+  ASSERT_EQ(j["scenes"].size(), 3u);
   const auto& sym = j["scenes"][0];
   const auto& gen = j["scenes"][1];
+  const auto& cen = j["scenes"][2];
   EXPECT_EQ(sym["scene"], "symmetric");
+  EXPECT_EQ(cen["scene"], "central");
   EXPECT_TRUE(sym["used_symmetry"].get<bool>());
+  EXPECT_FALSE(sym["used_central"].get<bool>());
   EXPECT_FALSE(gen["used_symmetry"].get<bool>());
+  EXPECT_TRUE(cen["used_symmetry"].get<bool>());
+  EXPECT_TRUE(cen["used_central"].get<bool>());
   EXPECT_LT(sym["targets"].get<int>(), gen["targets"].get<int>());
+  EXPECT_LT(cen["targets"].get<int>(), sym["targets"].get<int>());
   EXPECT_EQ(gen["targets"], 162);
-  for (const auto& s : {sym, gen}) {
+  for (const auto& s : {sym, gen, cen}) {
     double phases = 0.0;
     for (const char* k : {"membrane_ms", "load_ms", "layout_ms", "regular_ms", "far_ms", "singular_ms", "near_ms",
                           "volume_ms"}) {

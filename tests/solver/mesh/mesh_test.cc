@@ -1,5 +1,7 @@
 #include "solver/mesh/mesh.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -70,8 +72,41 @@ TEST_P(CapsuleMeshMaps, NodesOnSpheroidAndExactlyMirrorSymmetric) {
     EXPECT_EQ(m.nodes(1, j), x(1));
     EXPECT_EQ(m.nodes(2, j), -x(2));
     seen.insert(j);
+    // The central image: built on the sphere, so on the spheroid −x only to the rounding of the map (the
+    // polar angles θ and π − θ are mapped separately).
+    const int p = m.central_node[i];
+    ASSERT_GE(p, 0);
+    EXPECT_NE(p, i);
+    EXPECT_EQ(m.central_node[p], i);
+    EXPECT_LT((m.nodes.col(p) + x).norm(), 1e-14);
   }
   EXPECT_EQ(static_cast<int>(seen.size()), m.num_nodes());
+}
+
+// The sphere is centrally symmetric bitwise, and x → −x maps elements onto elements (as node sets), which is
+// what lets the flow evaluate one node of each pair: the discrete operator commutes with the symmetry.
+TEST(SphereMesh, CentralImagesAreNegatedNodesAndElements) {
+  for (int level = 0; level <= 3; ++level) {
+    const SurfaceMesh m = make_sphere_mesh(level);
+    ASSERT_EQ(static_cast<int>(m.central_node.size()), m.num_nodes());
+    std::set<std::array<int, 6>> elements;
+    for (auto e : m.elements) {
+      std::sort(e.begin(), e.end());
+      elements.insert(e);
+    }
+    for (int i = 0; i < m.num_nodes(); ++i) {
+      const int p = m.central_node[i];
+      EXPECT_EQ(m.central_node[p], i);
+      EXPECT_NE(p, i);
+      for (int k = 0; k < 3; ++k) EXPECT_EQ(m.nodes(k, p), -m.nodes(k, i)) << "level " << level << " node " << i;
+    }
+    for (const auto& e : m.elements) {
+      std::array<int, 6> image{};
+      for (int a = 0; a < 6; ++a) image[a] = m.central_node[e[a]];
+      std::sort(image.begin(), image.end());
+      EXPECT_TRUE(elements.count(image)) << "level " << level;
+    }
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(AspectRatios, CapsuleMeshMaps,
@@ -145,6 +180,55 @@ TEST(CapsuleMesh, SymmetriseProjectsOntoExactlyMirrorSymmetricStates) {
   Eigen::Matrix3Xd z = y;
   symmetrise(m, z);
   EXPECT_EQ((z - y).cwiseAbs().maxCoeff(), 0.0);  // idempotent
+}
+
+// With the central symmetry symmetrise projects onto states symmetric under the whole group (mirror, x → −x,
+// half-turn about x3): exact afterwards, bitwise idempotent, the even part of a perturbation removed, nodes on
+// the mirror plane at x3 = 0 and nodes on the x3 axis at x1 = x2 = 0 exactly. Central alone keeps the mirror
+// asymmetry that is odd under x → −x.
+TEST(CapsuleMesh, SymmetriseWithCentralProjectsOntoTheSymmetryGroup) {
+  const SurfaceMesh m = make_capsule_mesh(2, 0.5, SpheroidMap::EqualArcLength);
+  // An odd map of the reference keeps both symmetries: a shear and a cubic stretch along x1.
+  Eigen::Matrix3Xd x = m.nodes;
+  for (int i = 0; i < x.cols(); ++i) x(0, i) += 0.3 * x(1, i) + 0.1 * x(0, i) * x(0, i) * x(0, i);
+  EXPECT_FALSE(is_centrally_symmetric(m, x, 0.0));  // the spheroid map's rounding
+  EXPECT_TRUE(is_centrally_symmetric(m, x, 1e-14));
+  const Eigen::Matrix3Xd sym = x;
+  symmetrise(m, x, true, true);
+  EXPECT_TRUE(is_centrally_symmetric(m, x, 0.0));
+  EXPECT_TRUE(is_mirror_symmetric(m, x, 0.0));
+  // Moved by the map's rounding only: a few ulps of |x| ≤ 1.6.
+  EXPECT_LT((x - sym).cwiseAbs().maxCoeff(), 4e-15);
+  Eigen::Matrix3Xd again = x;
+  symmetrise(m, again, true, true);
+  EXPECT_EQ((again - x).cwiseAbs().maxCoeff(), 0.0);  // idempotent
+  int on_plane = 0, on_axis = 0;
+  for (int i = 0; i < x.cols(); ++i) {
+    if (m.mirror_node[i] == i) {
+      ++on_plane;
+      EXPECT_EQ(x(2, i), 0.0);
+    }
+    if (m.mirror_node[m.central_node[i]] == i) {
+      ++on_axis;
+      EXPECT_EQ(x(0, i), 0.0);
+      EXPECT_EQ(x(1, i), 0.0);
+    }
+  }
+  EXPECT_GT(on_plane, 0);
+  EXPECT_GT(on_axis, 0);
+  // An even perturbation (x1 += ε x2², invariant under x → −x) is removed; so is one that breaks the mirror.
+  Eigen::Matrix3Xd y = x;
+  for (int i = 0; i < y.cols(); ++i) y(0, i) += 1e-6 * y(1, i) * y(1, i), y(2, i) += 1e-6 * y(0, i);
+  EXPECT_FALSE(is_centrally_symmetric(m, y, 1e-10));
+  symmetrise(m, y, true, true);
+  EXPECT_LT((y - x).cwiseAbs().maxCoeff(), 1e-15);
+  // Central alone: the mirror-breaking tilt x3 += ε x1 is odd under x → −x and stays; the even part goes.
+  Eigen::Matrix3Xd z = x;
+  for (int i = 0; i < z.cols(); ++i) z(0, i) += 1e-6 * z(1, i) * z(1, i), z(2, i) += 1e-6 * z(0, i);
+  symmetrise(m, z, false, true);
+  EXPECT_TRUE(is_centrally_symmetric(m, z, 0.0));
+  EXPECT_FALSE(is_mirror_symmetric(m, z, 1e-10));
+  for (int i = 0; i < z.cols(); ++i) EXPECT_NEAR(z(2, i), x(2, i) + 1e-6 * x(0, i), 1e-15);
 }
 
 }  // namespace

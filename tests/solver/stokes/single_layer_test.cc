@@ -292,6 +292,102 @@ TEST(SingleLayer, MixedPrecisionKeepsTheMirrorPlaneExact) {
   EXPECT_LT((us - uf).cwiseAbs().maxCoeff() / uf.cwiseAbs().maxCoeff(), 1e-5);
 }
 
+// A deformed scene symmetric under the mirror and under x → −x: odd polynomials of the reference (exactly
+// symmetrised first, the spheroid map leaves its rounding), so x and q are exactly antisymmetric under x → −x,
+// and x1, x2, q1, q2 even and x3, q3 odd in x3.
+void centrally_symmetric_scene(const mesh::SurfaceMesh& m, Matrix3Xd& x, Matrix3Xd& q) {
+  Matrix3Xd X = m.nodes;
+  mesh::symmetrise(m, X, true, true);
+  x.resize(3, m.num_nodes());
+  q.resize(3, m.num_nodes());
+  for (int i = 0; i < m.num_nodes(); ++i) {
+    const double a = X(0, i), b = X(1, i), c = X(2, i);
+    x.col(i) << 1.3 * a + 0.4 * b + 0.1 * a * c * c, 0.8 * b - 0.2 * a * a * a, 0.9 * c + 0.1 * a * b * c;
+    q.col(i) << 0.5 * a + a * b * b, -0.3 * b + b * c * c, c * (1.0 + a * a);
+  }
+}
+
+// With the central symmetry a quarter of the nodes are evaluated and u(−x0) = −u(x0) fills the rest: the same
+// operator as the full evaluation to round-off in double (not bitwise the mirror-only one at shared targets:
+// the fast double kernel's 1/r differs between the blocks of a tile, so a target's last bits depend on its
+// position in the target list). Nodes fixed by a group element get the zeros the symmetry prescribes exactly,
+// in double and in mixed precision.
+TEST(SingleLayer, CentralSymmetricEvaluationEqualsFullEvaluation) {
+  const auto m = mesh::make_capsule_mesh(2, 0.5);
+  Matrix3Xd x, q;
+  centrally_symmetric_scene(m, x, q);
+  for (const auto precision : {KernelPrecision::Double, KernelPrecision::Mixed}) {
+    SingleLayerOptions full_opt, mirror_opt, central_opt;
+    full_opt.precision = mirror_opt.precision = central_opt.precision = precision;
+    full_opt.symmetry = Symmetry::Off;
+    central_opt.central_symmetry = true;
+    SingleLayer full(m, full_opt), mirror(m, mirror_opt), central(m, central_opt);
+    const Matrix3Xd uf = full.apply(x, q), um = mirror.apply(x, q), uc = central.apply(x, q);
+    ASSERT_TRUE(central.last_stats().used_central);
+    ASSERT_TRUE(central.last_stats().used_symmetry);
+    EXPECT_FALSE(mirror.last_stats().used_central);
+    EXPECT_LT(central.last_stats().targets, 0.3 * m.num_nodes());
+    const double scale = uf.cwiseAbs().maxCoeff();
+    const double diff = (uc - uf).cwiseAbs().maxCoeff() / scale;
+    std::printf("  %s: central vs full max diff / max |u| = %.2e (%d of %d targets; mirror alone %d)\n",
+                precision == KernelPrecision::Double ? "double" : "mixed", diff, central.last_stats().targets,
+                m.num_nodes(), mirror.last_stats().targets);
+    // Double: the same integrals summed in another order. Mixed: the float kernel's 3e-7, as for the mirror.
+    EXPECT_LT(diff, precision == KernelPrecision::Double ? 1e-13 : 1e-5);
+    int plane = 0, axis = 0;
+    for (const int i : central.last_targets()) {
+      const bool on_plane = m.mirror_node[i] == i, on_axis = m.mirror_node[m.central_node[i]] == i;
+      plane += on_plane;
+      axis += on_axis;
+      if (on_plane) {
+        EXPECT_EQ(uc(2, i), 0.0);
+      }
+      if (on_axis) {
+        EXPECT_EQ(uc(0, i), 0.0);
+        EXPECT_EQ(uc(1, i), 0.0);
+      }
+    }
+    EXPECT_GT(plane, 0);
+    EXPECT_GT(axis, 0);
+    for (int i = 0; i < m.num_nodes(); ++i)
+      for (int k = 0; k < 3; ++k) EXPECT_EQ(uc(k, m.central_node[i]), -uc(k, i)) << "node " << i;
+  }
+}
+
+// The central symmetry is used only where the scene has it: a load with an even part under x → −x (a uniform
+// one) keeps the mirror evaluation bit for bit; an off-plane tilt keeps the central one without the mirror
+// (half the nodes, one of each pair {x, −x}), equal to the full evaluation to round-off.
+TEST(SingleLayer, CentralSymmetryIsUsedOnlyWhereTheSceneHasIt) {
+  const auto m = mesh::make_capsule_mesh(2, 2.0);
+  Matrix3Xd x, q;
+  centrally_symmetric_scene(m, x, q);
+  SingleLayerOptions full_opt, central_opt;
+  full_opt.symmetry = Symmetry::Off;
+  central_opt.central_symmetry = true;
+  SingleLayer full(m, full_opt), mirror(m), central(m, central_opt);
+  Matrix3Xd q_even = q;
+  q_even.row(0).array() += 0.05;
+  const Matrix3Xd uc = central.apply(x, q_even);
+  EXPECT_FALSE(central.last_stats().used_central);
+  EXPECT_TRUE(central.last_stats().used_symmetry);
+  EXPECT_EQ((uc - mirror.apply(x, q_even)).cwiseAbs().maxCoeff(), 0.0);
+  // A tilt out of the shear plane, x3 += 0.2 x1 (odd under x → −x, not under the mirror).
+  Matrix3Xd x_tilt = x, q_tilt = q;
+  x_tilt.row(2) += 0.2 * x.row(0);
+  q_tilt.row(2) += 0.1 * q.row(0);
+  const Matrix3Xd ut = central.apply(x_tilt, q_tilt), ft = full.apply(x_tilt, q_tilt);
+  EXPECT_TRUE(central.last_stats().used_central);
+  EXPECT_FALSE(central.last_stats().used_symmetry);
+  EXPECT_EQ(central.last_stats().targets, m.num_nodes() / 2);
+  EXPECT_LT((ut - ft).cwiseAbs().maxCoeff() / ft.cwiseAbs().maxCoeff(), 1e-13);
+  // Symmetry::Off turns it off too.
+  SingleLayerOptions off = central_opt;
+  off.symmetry = Symmetry::Off;
+  SingleLayer none(m, off);
+  EXPECT_EQ((none.apply(x, q) - full.apply(x, q)).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_FALSE(none.last_stats().used_central);
+}
+
 // The operator's defaults are those of the case registry: a default-constructed operator (tests,
 // benchmarks) is the operator of a default case. (Before issue 12, duffy_order was 6 here and 8 there.)
 TEST(SingleLayer, DefaultsAreTheCaseRegistrys) {

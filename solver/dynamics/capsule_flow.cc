@@ -36,6 +36,7 @@ CapsuleFlow::CapsuleFlow(const config::CaseConfig& c) : Ca_(c.capillary_number) 
   so.far_radius = c.far_radius;
   so.precision = c.kernel_precision == "mixed" ? stokes::KernelPrecision::Mixed : stokes::KernelPrecision::Double;
   so.central_symmetry = c.central_symmetry;
+  central_symmetry_ = c.central_symmetry;
   single_layer_ = std::make_unique<stokes::SingleLayer>(*mesh_, so);
   volume_correction_ = c.volume_correction;
   flux_rule_ = mesh::P2Tabulation::of_degree(6);
@@ -49,7 +50,12 @@ membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Ei
 
 membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q, bool warm) {
   auto t0 = std::chrono::steady_clock::now();
-  membrane::MembraneState s = mechanics_->evaluate(x, /*with_energy=*/false);
+  // With numerics.central_symmetry and a centrally symmetric x (to the boundary integral's position tolerance),
+  // half the elements: the others are their images (MembraneMechanics::evaluate_centrally_symmetric).
+  membrane::MembraneState s =
+      central_symmetry_ && mesh::is_centrally_symmetric(*mesh_, x, single_layer_->options().symmetry_tol)
+          ? mechanics_->evaluate_centrally_symmetric(x, /*with_energy=*/false)
+          : mechanics_->evaluate(x, /*with_energy=*/false);
   timings_.membrane_s += seconds_since(t0);
   t0 = std::chrono::steady_clock::now();
   // With bending: its evaluation factorises the mass matrix on x (its two mass solves need it), and the

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -48,6 +49,39 @@ MembraneMechanics::MembraneMechanics(const mesh::SurfaceMesh& mesh, const Eigen:
     if (det < 1e-20 * max_area)
       throw std::invalid_argument("membrane: element " + std::to_string(i / nq) +
                                   " of the reference surface is degenerate");
+  }
+  // The elements' images under x → −x, for evaluate_centrally_symmetric: found by their node sets.
+  const int ne = mesh.num_elements();
+  if (static_cast<int>(mesh.central_node.size()) == mesh.num_nodes() && ne > 0) {
+    std::map<std::array<int, 6>, int> by_nodes;
+    for (int e = 0; e < ne; ++e) {
+      auto key = mesh.elements[e];
+      std::sort(key.begin(), key.end());
+      by_nodes.emplace(key, e);
+    }
+    std::vector<int> image(static_cast<std::size_t>(ne), -1);
+    std::vector<std::array<int, 6>> local(static_cast<std::size_t>(ne));
+    bool complete = true;
+    for (int e = 0; e < ne && complete; ++e) {
+      std::array<int, 6> key{};
+      for (int a = 0; a < 6; ++a) key[a] = mesh.central_node[mesh.elements[e][a]];
+      std::sort(key.begin(), key.end());
+      const auto it = by_nodes.find(key);
+      if (it == by_nodes.end() || it->second == e) {
+        complete = false;
+        break;
+      }
+      image[e] = it->second;
+      const auto& to = mesh.elements[it->second];
+      for (int a = 0; a < 6; ++a)
+        local[e][a] = static_cast<int>(std::find(to.begin(), to.end(), mesh.central_node[mesh.elements[e][a]]) - to.begin());
+    }
+    if (complete) {
+      central_element_ = std::move(image);
+      central_local_ = std::move(local);
+      for (int e = 0; e < ne; ++e)
+        if (e < central_element_[e]) central_half_.push_back(e);
+    }
   }
 }
 
@@ -113,6 +147,15 @@ Invariants invariants(const Ref& r, const PointKinematics& k) {
 }  // namespace
 
 MembraneState MembraneMechanics::evaluate(const Eigen::Matrix3Xd& x, bool with_energy) const {
+  return evaluate_elements(x, with_energy, nullptr);
+}
+
+MembraneState MembraneMechanics::evaluate_centrally_symmetric(const Eigen::Matrix3Xd& x, bool with_energy) const {
+  return evaluate_elements(x, with_energy, central_half_.empty() ? nullptr : &central_half_);
+}
+
+MembraneState MembraneMechanics::evaluate_elements(const Eigen::Matrix3Xd& x, bool with_energy,
+                                                   const std::vector<int>* elements) const {
   // Two phases, so that the result is bitwise the same for any thread count: (1) in parallel over elements,
   // each element's forces on its six nodes, energy and tension extremes into its own slot; (2) serially in
   // element order, the sums over elements. Per-call buffers keep evaluate() const and thread-safe.
@@ -120,8 +163,11 @@ MembraneState MembraneMechanics::evaluate(const Eigen::Matrix3Xd& x, bool with_e
   std::vector<double> force(static_cast<std::size_t>(ne) * 18), energy(static_cast<std::size_t>(ne)),
       lo(static_cast<std::size_t>(ne)), hi(static_cast<std::size_t>(ne));
   int first_collapsed = ne;
+  const int count = elements ? static_cast<int>(elements->size()) : ne;
+  const int* which = elements ? elements->data() : nullptr;
 #pragma omp parallel for schedule(static) reduction(min : first_collapsed)
-  for (int e = 0; e < ne; ++e) {
+  for (int k = 0; k < count; ++k) {
+    const int e = which ? which[k] : k;
     const auto& el = mesh_.elements[e];
     double fe[6][3] = {}, we = 0.0;
     double tmin = std::numeric_limits<double>::infinity(), tmax = -std::numeric_limits<double>::infinity();
@@ -160,6 +206,20 @@ MembraneState MembraneMechanics::evaluate(const Eigen::Matrix3Xd& x, bool with_e
     hi[e] = tmax;
   }
   if (first_collapsed < ne) collapsed(first_collapsed);  // the lowest such element, as a serial loop would
+  if (which) {
+    // The image of each evaluated element: R is odd under x → −x, so its forces are the negated ones on the
+    // image nodes; energy and tension extremes are the same.
+    for (int k = 0; k < count; ++k) {
+      const int e = which[k], p = central_element_[e];
+      const double* from = force.data() + static_cast<std::size_t>(e) * 18;
+      double* to = force.data() + static_cast<std::size_t>(p) * 18;
+      for (int a = 0; a < 6; ++a)
+        for (int c = 0; c < 3; ++c) to[3 * central_local_[e][a] + c] = -from[3 * a + c];
+      energy[p] = energy[e];
+      lo[p] = lo[e];
+      hi[p] = hi[e];
+    }
+  }
   MembraneState s;
   s.internal_force = Eigen::Matrix3Xd::Zero(3, x.cols());
   s.tau_min = std::numeric_limits<double>::infinity();

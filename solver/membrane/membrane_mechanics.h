@@ -58,6 +58,16 @@ class MembraneMechanics {
   /// @throws DegenerateSurface if an element is flipped or collapsed.
   [[nodiscard]] MembraneState evaluate(const Eigen::Matrix3Xd& x, bool with_energy = true) const;
 
+  /// @brief The same, for positions x centrally symmetric (x_P(i) = −x_i, mesh.central_node) to round-off: each
+  /// pair of image elements {e, P(e)} is evaluated once and the image gets the negated forces on the image
+  /// nodes (the internal force R is odd under x → −x, the tensions and energy are even), half the work. Only
+  /// for such x (the caller checks: CapsuleFlow with numerics.central_symmetry); falls back to evaluate() if
+  /// the mesh has no central map. Forces agree with evaluate() to round-off, not bitwise.
+  [[nodiscard]] MembraneState evaluate_centrally_symmetric(const Eigen::Matrix3Xd& x, bool with_energy = true) const;
+  /// @brief Whether evaluate_centrally_symmetric can use the symmetry (the mesh has a central map that maps
+  /// elements onto elements).
+  [[nodiscard]] bool has_central_map() const { return !central_element_.empty(); }
+
   /// @brief Elastic energy W only (for finite-difference checks).
   [[nodiscard]] double energy(const Eigen::Matrix3Xd& x) const;
 
@@ -77,11 +87,18 @@ class MembraneMechanics {
   };
   template <class Visit>
   void for_each_point(const Eigen::Matrix3Xd& x, Visit&& visit) const;
+  // Both evaluations: the elements in `elements` (all when null), then the images of those when `images`.
+  MembraneState evaluate_elements(const Eigen::Matrix3Xd& x, bool with_energy, const std::vector<int>* elements) const;
 
   const mesh::SurfaceMesh& mesh_;
   const MembraneLaw& law_;
   mesh::P2Tabulation p2_;                                  // the rule's points
   std::vector<RefPoint> ref_;                              // element-major, per rule point
+  // x → −x on elements (mesh.central_node; empty if none): the image element of each element, the local
+  // index in it of the image of each local node, and one element of each pair (the smaller index).
+  std::vector<int> central_element_;
+  std::vector<std::array<int, 6>> central_local_;
+  std::vector<int> central_half_;
 };
 
 /// @brief Surface area ∫_S dS and enclosed volume (1/3)∫_S x·n dS of positions x on the exact P2 geometry.

@@ -92,14 +92,17 @@ class Runner {
   /// many cases it added to the campaign (refine_campaign's top-up). New cases join the queue in --order.
   using TopUp = std::function<int(const std::vector<CaseParams>& unfinished)>;
   void set_top_up(TopUp top_up) { top_up_ = std::move(top_up); }
-  /// Queue the coarser mesh levels first (then --order within a level): in a multi-fidelity campaign a
-  /// scan case gates its cell's whole answer level, so it must not wait behind another cell's answer cases.
+  /// Queue the coarser mesh levels first and, within a level, cell by cell (cells whose round has started,
+  /// then by their queued work; --order within a cell): in a multi-fidelity campaign a scan case gates its
+  /// cell's whole answer level, and a cell's next round waits for the last case of its round
+  /// (order_by_level_and_cell).
   void set_coarse_levels_first(bool on) { coarse_levels_first_ = on; }
 
   /// Runs every queued case of the campaign (and what the top-up adds meanwhile); returns false if stopped
   /// by a signal.
   bool run_queued() {
     learn_costs();
+    started_cells_.clear();  // nothing runs yet
     auto rows = store_.campaign_cases(campaign_id_);
     std::vector<CaseRow> pending = startable(rows);
     order(pending);
@@ -126,7 +129,10 @@ class Runner {
       }
       const std::size_t before = running_.size();
       reap();
-      top_up_due |= running_.size() < before;
+      if (running_.size() < before) {
+        top_up_due = true;
+        close_rounds(pending);
+      }
       if (top_up_ && top_up_due && !g_stop_signal && (!pending.empty() || !running_.empty()) &&
           static_cast<int>(running_.size()) < jobs_) {
         top_up_due = false;
@@ -177,14 +183,16 @@ class Runner {
     // start last); shortest first completes the most answers per hour of one that will be interrupted.
     // Both by the work left: a case that resumes from a checkpoint at γ̇t = 30 of 40 is a quarter of a case
     // (an interrupted level-4 case is then finished first by `--order shortest`, not left behind whole ones).
-    if (opt_.order == "longest" || opt_.order == "shortest") {
-      // The whole case as the ETA predicts it (wall ∝ est^β per level), the estimate itself before any finished.
-      std::map<std::string, double> left;
+    const bool by_work = opt_.order == "longest" || opt_.order == "shortest";
+    // The whole case as the ETA predicts it (wall ∝ est^β per level), the estimate itself before any finished.
+    std::map<std::string, double> left;
+    if (by_work || coarse_levels_first_)
       for (const auto& r : pending) {
         const double whole = eta_.expected_s(r.params.mesh_level(), r.est_cost);
         left[r.case_id] = (whole >= 0 ? whole : r.est_cost) *
                           (r.resumable ? work_fraction_left(r.out_dir, r.params.t_end()) : 1.0);
       }
+    if (by_work) {
       // Equal estimates are common (the stage count at rest is an integer): the smaller Ca counts as longer,
       // since its stiffness is the larger and the prestress of the run adds its next stage sooner.
       const auto longer = [&](const CaseRow& a, const CaseRow& b) {
@@ -195,11 +203,63 @@ class Runner {
       std::stable_sort(pending.begin(), pending.end(),
                        [&](const CaseRow& a, const CaseRow& b) { return longest ? longer(a, b) : longer(b, a); });
     }
-    if (coarse_levels_first_)
-      std::stable_sort(pending.begin(), pending.end(), [](const CaseRow& a, const CaseRow& b) {
-        return a.params.mesh_level() < b.params.mesh_level();
-      });
+    if (coarse_levels_first_) order_by_level_and_cell(pending, left);
     std::reverse(pending.begin(), pending.end());  // pop_back = next case
+  }
+
+  // Multi-fidelity: the coarser levels first, since a scan case gates its cell's whole answer level. Within a
+  // level the queue goes cell by cell, because refine_campaign releases a cell's next round only when none of
+  // its cases runs or waits: a round is of no use to its cell's chain of rounds until its last case ends.
+  // Longest first across cells scattered each round over the whole queue: in the main command (2 workers,
+  // results/main_command_15min/README.md) the three cheap CaH cases of the Skalak a/b 0.5 cell's level-3 round
+  // (25–31 s) waited ≈ 11 min behind the other cells' long cases, and the rounds that needed them (≈ 2–3 min of
+  // dependent cases) then ran alone at the end, one core idle for the last ≈ 215 s. A worker idles only when
+  // nothing is queued and what is left waits for a running case of its own cell, so the rule releases rounds
+  // as early as it can and starts the big ones early:
+  //  1. cells whose round has started (started_cells_) first: finishing it releases the cell's next round, which
+  //     then runs beside the other cells' cases; those cost the same later, whereas a started round left
+  //     half-run delays its cell's whole chain (the scatter above, in small: a new round added by the top-up
+  //     would otherwise go ahead of a started one with less left). A started cell goes first whatever its
+  //     running cases still take: that time passes whatever is queued behind them, so it is not in the rank.
+  //  2. then the most queued work first, from `left` whatever --order is (the best estimate of seconds: the ETA
+  //     per level, a resumed case by what it has left; with `--order grid` too, so that grid chooses only the
+  //     order within a cell): the queued work is what is known of a cell's chain (its later rounds are not),
+  //     and a big round started last is the idle tail that longest first avoids for single cases. With
+  //     `--order shortest` the least work first instead: that order is for a campaign that will be interrupted
+  //     (a certified table's level-4 checks), and a cell's answer is complete only when all of its cases are.
+  //  3. ties by cell key; within a cell, --order (the stable sort keeps the order it was given).
+  // Plain campaigns (one level) keep --order alone.
+  void order_by_level_and_cell(std::vector<CaseRow>& pending, const std::map<std::string, double>& left) const {
+    std::map<std::string, std::string> cell;  // case id -> cell_key
+    std::map<std::pair<int, std::string>, double> queued_work;  // (mesh level, cell) -> work left of its queued cases
+    for (const auto& r : pending) {
+      const std::string c = cell_key(group_key(r.params));
+      cell[r.case_id] = c;
+      queued_work[{r.params.mesh_level(), c}] += left.at(r.case_id);
+    }
+    const bool least_work_first = opt_.order == "shortest";
+    std::stable_sort(pending.begin(), pending.end(), [&](const CaseRow& a, const CaseRow& b) {
+      const int level_a = a.params.mesh_level(), level_b = b.params.mesh_level();
+      if (level_a != level_b) return level_a < level_b;
+      const std::string& cell_a = cell.at(a.case_id);
+      const std::string& cell_b = cell.at(b.case_id);
+      if (cell_a == cell_b) return false;
+      const bool started_a = started_cells_.count(cell_a) > 0, started_b = started_cells_.count(cell_b) > 0;
+      if (started_a != started_b) return started_a;
+      const double work_a = queued_work.at({level_a, cell_a}), work_b = queued_work.at({level_b, cell_b});
+      if (work_a != work_b) return least_work_first ? work_a < work_b : work_a > work_b;
+      return cell_a < cell_b;
+    });
+  }
+
+  // A cell's round ends when none of its cases runs or waits (refine_campaign may then add the next one, which
+  // has not started): called after cases end, before the top-up.
+  void close_rounds(const std::vector<CaseRow>& pending) {
+    if (started_cells_.empty()) return;
+    std::set<std::string> live;
+    for (const auto& [_, r] : running_) live.insert(cell_key(group_key(r.row.params)));
+    for (const auto& r : pending) live.insert(cell_key(group_key(r.params)));
+    std::erase_if(started_cells_, [&](const std::string& c) { return live.count(c) == 0; });
   }
 
   ProgressCounts counts(const std::vector<CaseRow>& pending) const {
@@ -222,6 +282,7 @@ class Runner {
   }
 
   void start(CaseRow row) {
+    if (coarse_levels_first_) started_cells_.insert(cell_key(group_key(row.params)));
     row.out_dir = prepare_case_folder(row, runs_dir_);
     store_.set_case_folder(row.case_id, row.out_dir);
     const std::string toml = row.out_dir + "/case.toml";
@@ -294,6 +355,7 @@ class Runner {
   EtaModel eta_;  // per mesh level, wall seconds against estimated cost of the campaign's finished cases
   TopUp top_up_;  // empty: the queue is all there is until run_queued returns
   bool coarse_levels_first_ = false;
+  std::set<std::string> started_cells_;  // multi-fidelity: the cells a case of whose current round has started
 };
 
 /// After a manager crash: stop leftover workers, then ingest finished results or requeue.
@@ -598,8 +660,10 @@ int run_campaign(const RunOptions& opt, const BeforeRun& before_run) {
   std::map<std::string, int> cell_rounds;
   const bool multi_fidelity = !spec.analysis.levels.empty();
   // Cells run ahead of each other, so a cell's scan case must not queue behind another cell's answer-level cases:
-  // the coarser levels first. (It did not shorten the main command's idle tail, which is the last cell's chain
-  // of dependent rounds: results/main_command_15min/README.md.)
+  // the coarser levels first. That alone did not shorten the main command's idle tail, the last cell's chain of
+  // dependent rounds (results/main_command_15min/README.md): longest first across cells had spread that cell's
+  // round over the queue, and its next round waits for the round's last case. So within a level the queue also
+  // goes cell by cell, a started round first, then the cells with the most queued work (Runner::order).
   runner.set_coarse_levels_first(multi_fidelity);
   if (multi_fidelity)
     runner.set_top_up([&](const std::vector<CaseParams>& unfinished) {

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 #include <nlohmann/json.hpp>
@@ -243,6 +245,49 @@ capillary_number = [0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.6]
   EXPECT_EQ(levels.find('1', levels.find('2')), std::string::npos) << levels;
   EXPECT_EQ(cases(dir + "/one.db"), cases(dir + "/plain.db"));
   EXPECT_EQ(table(dir + "/one.db"), table(dir + "/plain.db"));
+}
+
+// A cell's next round waits for the last case of its round, so the queue keeps a cell's round together and
+// takes the cell with the most queued work first (Runner::order_by_level_and_cell). Longest first across cells
+// had spread a round over the queue: on the main command a cell's cheap cases waited ≈ 11 min behind the other
+// cells' long ones and its later rounds ran alone at the end (results/main_command_15min/README.md). Two cells,
+// one worker: the oblate cell has the most scan work, the prolate one the single longest scan case (Ca 0.005).
+TEST(MultiFidelity, ACellsRoundRunsAsOneBlockTheCellWithTheMostQueuedWorkFirst) {
+  const std::string dir = fresh_dir("multi_fidelity_cell_blocks");
+  write_file(dir + "/mf.toml", "[campaign]\nname = \"mf\"\n" + std::string(R"([[grid]]
+aspect_ratio = [2.0]
+law = ["neo-hookean"]
+capillary_number = [0.005, 0.15, 0.2, 0.3, 0.6]
+)") + kOblateGrid + "levels = [1, 2]\ndt_check = true\n");
+  const std::string db = dir + "/one.db";
+  auto r = sh(campaign_cmd("FAKE_STEPS=1 FAKE_STEP_S=0.001 FAKE_LEVEL_SHIFT=0.08", dir + "/mf.toml", db, "--jobs 1"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  ASSERT_NE(r.err.find(", while "), std::string::npos)
+      << "a cell took a round while the other's cases waited: " << r.err;
+
+  // The scenario: the cell with the most scan work (the estimate; no case has finished to calibrate it) is not
+  // the one with the longest scan case, which longest first starts with.
+  const std::string work = sql(db, "SELECT aspect_ratio FROM cases WHERE mesh_level = 1 GROUP BY aspect_ratio "
+                                   "ORDER BY SUM(est_cost) DESC LIMIT 1");
+  ASSERT_EQ(work, "0.5\n");
+  ASSERT_EQ(sql(db, "SELECT aspect_ratio FROM cases WHERE mesh_level = 1 ORDER BY est_cost DESC LIMIT 1"), "2\n");
+
+  // The cases in the order they started, each with its round: a cell's cases added at once (one top-up) were
+  // all created after the same set of its cases had finished, and before any of their own finished.
+  const std::string started = sql(
+      db, "SELECT c.aspect_ratio || ' level ' || c.mesh_level || ' after ' || (SELECT COUNT(*) FROM cases d "
+          "WHERE d.aspect_ratio = c.aspect_ratio AND d.finished_at <= c.created_at) || ' of its cases' "
+          "FROM attempts a JOIN cases c USING(case_id) ORDER BY a.attempt_id");
+  std::vector<std::string> rounds;  // one entry per block of consecutive starts of one round
+  std::istringstream lines(started);
+  for (std::string line; std::getline(lines, line);)
+    if (rounds.empty() || rounds.back() != line) rounds.push_back(line);
+  ASSERT_GT(rounds.size(), 4u) << started;
+  EXPECT_EQ(rounds.front().substr(0, 4), "0.5 ") << "the cell with the most queued work first:\n" << started;
+  std::set<std::string> seen;
+  for (const auto& round : rounds)
+    EXPECT_TRUE(seen.insert(round).second) << "another cell's case started within the round " << round << ":\n"
+                                           << started;
 }
 
 }  // namespace

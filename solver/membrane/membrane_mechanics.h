@@ -87,7 +87,7 @@ class MembraneMechanics {
   };
   template <class Visit>
   void for_each_point(const Eigen::Matrix3Xd& x, Visit&& visit) const;
-  // Both evaluations: the elements in `elements` (all when null), then the images of those when `images`.
+  // Both evaluations: the elements in `elements` (all when null) and, when given, their images from the central map.
   MembraneState evaluate_elements(const Eigen::Matrix3Xd& x, bool with_energy, const std::vector<int>* elements) const;
 
   const mesh::SurfaceMesh& mesh_;

@@ -280,26 +280,31 @@ Eigen::Matrix3Xd node_normals(const SurfaceMesh& m, const Eigen::Matrix3Xd& x) {
   return n;
 }
 
-bool is_mirror_symmetric(const SurfaceMesh& m, const Eigen::Matrix3Xd& x, double tol) {
-  if (static_cast<int>(m.mirror_node.size()) != x.cols() || x.cols() == 0) return false;
-  const double scale = tol * (x.rowwise().maxCoeff() - x.rowwise().minCoeff()).norm();
-  for (int i = 0; i < x.cols(); ++i) {
-    const int j = m.mirror_node[i];
-    const double e = std::abs(x(0, i) - x(0, j)) + std::abs(x(1, i) - x(1, j)) + std::abs(x(2, i) + x(2, j));
-    if (!(e <= scale)) return false;
+bool symmetric_under(std::span<const int> image, const std::array<double, 3>& signs, const Eigen::Matrix3Xd& v,
+                     double tol) {
+  if (static_cast<Eigen::Index>(image.size()) != v.cols()) return false;
+  for (Eigen::Index i = 0; i < v.cols(); ++i) {
+    const int j = image[static_cast<std::size_t>(i)];
+    const double e = std::abs(v(0, j) - signs[0] * v(0, i)) + std::abs(v(1, j) - signs[1] * v(1, i)) +
+                     std::abs(v(2, j) - signs[2] * v(2, i));
+    if (!(e <= tol)) return false;  // also false for NaN
   }
   return true;
 }
 
+namespace {
+// tol relative to the extent of x (the diagonal of its bounding box).
+double relative_to_extent(const Eigen::Matrix3Xd& x, double tol) {
+  return tol * (x.rowwise().maxCoeff() - x.rowwise().minCoeff()).norm();
+}
+}  // namespace
+
+bool is_mirror_symmetric(const SurfaceMesh& m, const Eigen::Matrix3Xd& x, double tol) {
+  return x.cols() > 0 && symmetric_under(m.mirror_node, kMirrorSigns, x, relative_to_extent(x, tol));
+}
+
 bool is_centrally_symmetric(const SurfaceMesh& m, const Eigen::Matrix3Xd& x, double tol) {
-  if (static_cast<int>(m.central_node.size()) != x.cols() || x.cols() == 0) return false;
-  const double scale = tol * (x.rowwise().maxCoeff() - x.rowwise().minCoeff()).norm();
-  for (int i = 0; i < x.cols(); ++i) {
-    const int j = m.central_node[i];
-    const double e = std::abs(x(0, i) + x(0, j)) + std::abs(x(1, i) + x(1, j)) + std::abs(x(2, i) + x(2, j));
-    if (!(e <= scale)) return false;
-  }
-  return true;
+  return x.cols() > 0 && symmetric_under(m.central_node, kCentralSigns, x, relative_to_extent(x, tol));
 }
 
 void symmetrise(const SurfaceMesh& m, Eigen::Matrix3Xd& x, bool mirror, bool central) {
@@ -309,7 +314,7 @@ void symmetrise(const SurfaceMesh& m, Eigen::Matrix3Xd& x, bool mirror, bool cen
   if (!mirror && !central) return;
   // The group elements as sign patterns: identity, mirror M, point reflection P, half-turn R = M P.
   using Signs = std::array<double, 3>;
-  constexpr Signs kM{1.0, 1.0, -1.0}, kP{-1.0, -1.0, -1.0}, kR{-1.0, -1.0, 1.0};
+  constexpr Signs kM = kMirrorSigns, kP = kCentralSigns, kR{-1.0, -1.0, 1.0};
   const auto image = [&](const Signs& g, int j) {
     return Eigen::Vector3d(g[0] * x(0, j), g[1] * x(1, j), g[2] * x(2, j));
   };

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -94,6 +95,16 @@ Eigen::Matrix3Xd node_normals(const SurfaceMesh& mesh, const Eigen::Matrix3Xd& x
 /// @brief Parse a spheroid-map name ("conformal" | "equal-arc-length" | "axis-scaling").
 /// @throws std::invalid_argument naming the accepted values.
 SpheroidMap parse_spheroid_map(const std::string& name);
+
+/// @brief Sign patterns of the symmetries as diagonal maps: the mirror x3 → −x3 and the point reflection x → −x.
+inline constexpr std::array<double, 3> kMirrorSigns{1.0, 1.0, -1.0};
+inline constexpr std::array<double, 3> kCentralSigns{-1.0, -1.0, -1.0};
+
+/// @brief Whether the nodal field v maps onto itself under a symmetry: Σ_k |v(k, image[i]) − signs[k] v(k, i)| ≤ tol
+/// (absolute) at every node i; false for a NaN or if image does not have one entry per column of v. The one check
+/// behind the mesh's and the boundary integral's symmetry tests (positions, loads).
+bool symmetric_under(std::span<const int> image, const std::array<double, 3>& signs, const Eigen::Matrix3Xd& v,
+                     double tol);
 
 /// @brief Whether x is mirror-symmetric under x3 → −x3 (mirror_node pairs) to `tol` relative to the extent
 /// of x; false if the mesh has no mirror map.

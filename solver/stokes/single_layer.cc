@@ -173,32 +173,21 @@ void SingleLayer::copy_connectivity(const mesh::SurfaceMesh& mesh) {
   std::stable_sort(node_order_.begin(), node_order_.end(), [&](int a, int b) { return first[a] < first[b]; });
 }
 
-bool SingleLayer::is_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) const {
-  if (mirror_.empty() || x.cols() != num_nodes_ || q.cols() != num_nodes_) return false;
+bool SingleLayer::symmetric_scene(const std::vector<int>& image, const std::array<double, 3>& signs,
+                                  const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) const {
+  if (image.empty() || x.cols() != num_nodes_ || q.cols() != num_nodes_) return false;
   const double lx = (x.rowwise().maxCoeff() - x.rowwise().minCoeff()).norm();
   const double lq = q.colwise().norm().maxCoeff();
-  const double tx = opt_.symmetry_tol * lx, tq = opt_.load_symmetry_tol * lq;
-  for (int i = 0; i < num_nodes_; ++i) {
-    const int m = mirror_[i];
-    const double ex = std::abs(x(0, m) - x(0, i)) + std::abs(x(1, m) - x(1, i)) + std::abs(x(2, m) + x(2, i));
-    const double eq = std::abs(q(0, m) - q(0, i)) + std::abs(q(1, m) - q(1, i)) + std::abs(q(2, m) + q(2, i));
-    if (!(ex <= tx) || !(eq <= tq)) return false;  // also false for NaN
-  }
-  return true;
+  return mesh::symmetric_under(image, signs, x, opt_.symmetry_tol * lx) &&
+         mesh::symmetric_under(image, signs, q, opt_.load_symmetry_tol * lq);
+}
+
+bool SingleLayer::is_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) const {
+  return symmetric_scene(mirror_, mesh::kMirrorSigns, x, q);
 }
 
 bool SingleLayer::is_centrally_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) const {
-  if (central_.empty() || x.cols() != num_nodes_ || q.cols() != num_nodes_) return false;
-  const double lx = (x.rowwise().maxCoeff() - x.rowwise().minCoeff()).norm();
-  const double lq = q.colwise().norm().maxCoeff();
-  const double tx = opt_.symmetry_tol * lx, tq = opt_.load_symmetry_tol * lq;
-  for (int i = 0; i < num_nodes_; ++i) {
-    const int p = central_[i];
-    const double ex = std::abs(x(0, p) + x(0, i)) + std::abs(x(1, p) + x(1, i)) + std::abs(x(2, p) + x(2, i));
-    const double eq = std::abs(q(0, p) + q(0, i)) + std::abs(q(1, p) + q(1, i)) + std::abs(q(2, p) + q(2, i));
-    if (!(ex <= tx) || !(eq <= tq)) return false;  // also false for NaN
-  }
-  return true;
+  return symmetric_scene(central_, mesh::kCentralSigns, x, q);
 }
 
 kernel::Sources SingleLayer::build_sources(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) {

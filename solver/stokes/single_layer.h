@@ -179,6 +179,10 @@ class SingleLayer {
   // Constructor phase: connectivity copied from the mesh (checked), node → (element, local index).
   void copy_connectivity(const mesh::SurfaceMesh& mesh);
   // apply() phases (see the file comment).
+  // Whether positions and loads map onto themselves under the node map `image` with the sign pattern `signs`,
+  // to symmetry_tol and load_symmetry_tol (the checks of is_symmetric, is_centrally_symmetric).
+  [[nodiscard]] bool symmetric_scene(const std::vector<int>& image, const std::array<double, 3>& signs,
+                                     const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) const;
   void select_targets(const Eigen::Matrix3Xd& x, bool symmetric, bool central);
   void regular_sum(const kernel::Sources& src, Eigen::Matrix3Xd& u);
   long long far_field(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Eigen::Matrix3Xd& u);

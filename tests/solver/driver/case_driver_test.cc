@@ -329,6 +329,37 @@ TEST(CaseDriver, BendingRunIsStableRecordedAndResumesBitwise) {
   EXPECT_TRUE(io::read_case_file(rdir / "case.h5").series == series);
 }
 
+// A case option that must not change the case beyond `bound`: `variant` against `base` takes the same evaluations,
+// D12 moves at some sample (the option is in use) but by less than `bound` at every one, and `variant` interrupted
+// halfway resumes bitwise (its checkpoint carries what the option needs, or the option needs nothing carried).
+void expect_same_case_and_bitwise_resume(const config::CaseConfig& base, const config::CaseConfig& variant,
+                                         const std::string& name, double bound) {
+  const auto base_dir = scratch(name + "_off");
+  const CaseResult off = run_case(base, quiet_in(base_dir));
+  ASSERT_EQ(off.status, "done") << off.reason;
+  const auto dir = scratch(name + "_full");
+  const CaseResult full = run_case(variant, quiet_in(dir));
+  ASSERT_EQ(full.status, "done") << full.reason;
+  EXPECT_EQ(full.flow_evaluations, off.flow_evaluations);
+  const auto series = io::read_case_file(dir / "case.h5").series;
+  const auto off_series = io::read_case_file(base_dir / "case.h5").series;
+  ASSERT_EQ(series.size(), off_series.size());
+  double largest = 0.0;
+  for (std::size_t i = 0; i < series.size(); ++i) largest = std::max(largest, std::abs(series.D12[i] - off_series.D12[i]));
+  EXPECT_GT(largest, 0.0) << name << ": the option is not used";
+  EXPECT_LT(largest, bound) << name << ": D12 moved by more than the option allows";
+  const auto rdir = scratch(name + "_resumed");
+  RunOptions o = quiet_in(rdir);
+  o.stop_after_steps = full.steps / 2 + 1;
+  ASSERT_EQ(run_case(variant, o).status, "interrupted");
+  o.stop_after_steps = 0;
+  o.resume = true;
+  const CaseResult resumed = run_case(variant, o);
+  EXPECT_EQ(resumed.steps, full.steps);
+  EXPECT_EQ(resumed.flow_evaluations, full.flow_evaluations);
+  EXPECT_TRUE(io::read_case_file(rdir / "case.h5").series == series) << name;
+}
+
 // numerics.load_warm_start carries the previous stage's load into the next solve, but never across a step
 // (CapsuleFlow::begin_step): a run interrupted between steps and resumed repeats the uninterrupted one bitwise.
 // Its answers stay those of the cold solve to far below the time-step error.
@@ -339,51 +370,19 @@ TEST(CaseDriver, WarmStartedLoadSolvesResumeBitwise) {
   c.capillary_number = 0.05;
   c.level = 2;
   c.t_end = 0.6;
-  const auto cold_dir = scratch("warm_off");
-  const CaseResult cold = run_case(c, quiet_in(cold_dir));
-  ASSERT_EQ(cold.status, "done") << cold.reason;
-  c.load_warm_start = true;
-  const auto dir = scratch("warm_full");
-  const CaseResult full = run_case(c, quiet_in(dir));
-  ASSERT_EQ(full.status, "done") << full.reason;
-  EXPECT_EQ(full.flow_evaluations, cold.flow_evaluations);
-  const auto series = io::read_case_file(dir / "case.h5").series;
-  const auto cold_series = io::read_case_file(cold_dir / "case.h5").series;
-  ASSERT_EQ(series.size(), cold_series.size());
-  double largest = 0.0;
-  for (std::size_t i = 0; i < series.size(); ++i) largest = std::max(largest, std::abs(series.D12[i] - cold_series.D12[i]));
-  EXPECT_GT(largest, 0.0) << "the warm start is not used";
-  EXPECT_LT(largest, 1e-9) << "D12 moved by more than the load tolerance allows";
-  const auto rdir = scratch("warm_resumed");
-  RunOptions o = quiet_in(rdir);
-  o.stop_after_steps = full.steps / 2 + 1;
-  ASSERT_EQ(run_case(c, o).status, "interrupted");
-  o.stop_after_steps = 0;
-  o.resume = true;
-  const CaseResult resumed = run_case(c, o);
-  EXPECT_EQ(resumed.steps, full.steps);
-  EXPECT_EQ(resumed.flow_evaluations, full.flow_evaluations);
-  EXPECT_TRUE(io::read_case_file(rdir / "case.h5").series == series);
+  config::CaseConfig warm = c;
+  warm.load_warm_start = true;
+  // D12 within the load tolerance's reach.
+  expect_same_case_and_bitwise_resume(c, warm, "warm", 1e-9);
 
   // With bending stiffness the load is solved on the mass matrix the bending evaluation factorised (another
-  // path through LoadSolver): the warm start must agree with the cold solve there too.
+  // path through LoadSolver): the warm start must agree with the cold solve there too, and resume bitwise.
   c.level = 1;
   c.t_end = 0.3;
   c.bending_modulus = 1e-2;
-  c.load_warm_start = false;
-  const auto bent_cold_dir = scratch("warm_bending_off");
-  ASSERT_EQ(run_case(c, quiet_in(bent_cold_dir)).status, "done");
-  c.load_warm_start = true;
-  const auto bent_dir = scratch("warm_bending_on");
-  ASSERT_EQ(run_case(c, quiet_in(bent_dir)).status, "done");
-  const auto bent_cold = io::read_case_file(bent_cold_dir / "case.h5").series;
-  const auto bent = io::read_case_file(bent_dir / "case.h5").series;
-  ASSERT_EQ(bent.size(), bent_cold.size());
-  double bent_largest = 0.0;
-  for (std::size_t i = 0; i < bent.size(); ++i)
-    bent_largest = std::max(bent_largest, std::abs(bent.D12[i] - bent_cold.D12[i]));
-  EXPECT_GT(bent_largest, 0.0) << "the warm start is not used with bending";
-  EXPECT_LT(bent_largest, 1e-9);
+  warm = c;
+  warm.load_warm_start = true;
+  expect_same_case_and_bitwise_resume(c, warm, "warm_bending", 1e-9);
 }
 
 // numerics.central_symmetry: the same case as without it (in double the operator is the same to round-off, so
@@ -396,32 +395,10 @@ TEST(CaseDriver, CentralSymmetryGivesTheSameCaseAndResumesBitwise) {
   c.capillary_number = 0.05;
   c.level = 2;
   c.t_end = 0.6;
-  const auto mirror_dir = scratch("central_off");
-  const CaseResult mirror = run_case(c, quiet_in(mirror_dir));
-  ASSERT_EQ(mirror.status, "done") << mirror.reason;
-  c.central_symmetry = true;
-  const auto dir = scratch("central_full");
-  const CaseResult full = run_case(c, quiet_in(dir));
-  ASSERT_EQ(full.status, "done") << full.reason;
-  EXPECT_EQ(full.flow_evaluations, mirror.flow_evaluations);
-  const auto series = io::read_case_file(dir / "case.h5").series;
-  const auto mirror_series = io::read_case_file(mirror_dir / "case.h5").series;
-  ASSERT_EQ(series.size(), mirror_series.size());
-  double largest = 0.0;
-  for (std::size_t i = 0; i < series.size(); ++i)
-    largest = std::max(largest, std::abs(series.D12[i] - mirror_series.D12[i]));
-  EXPECT_GT(largest, 0.0) << "the central symmetry is not used";
+  config::CaseConfig central = c;
+  central.central_symmetry = true;
   // Double precision: the two operators differ by round-off (1e-14 of u), grown over 30 steps.
-  EXPECT_LT(largest, 1e-11) << "D12 moved by more than round-off";
-  const auto rdir = scratch("central_resumed");
-  RunOptions o = quiet_in(rdir);
-  o.stop_after_steps = full.steps / 2 + 1;
-  ASSERT_EQ(run_case(c, o).status, "interrupted");
-  o.stop_after_steps = 0;
-  o.resume = true;
-  const CaseResult resumed = run_case(c, o);
-  EXPECT_EQ(resumed.steps, full.steps);
-  EXPECT_TRUE(io::read_case_file(rdir / "case.h5").series == series);
+  expect_same_case_and_bitwise_resume(c, central, "central", 1e-11);
 }
 
 }  // namespace

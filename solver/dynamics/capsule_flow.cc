@@ -51,11 +51,13 @@ membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Ei
 membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q, bool warm) {
   auto t0 = std::chrono::steady_clock::now();
   // With numerics.central_symmetry and a centrally symmetric x (to the boundary integral's position tolerance),
-  // half the elements: the others are their images (MembraneMechanics::evaluate_centrally_symmetric).
-  membrane::MembraneState s =
-      central_symmetry_ && mesh::is_centrally_symmetric(*mesh_, x, single_layer_->options().symmetry_tol)
-          ? mechanics_->evaluate_centrally_symmetric(x, /*with_energy=*/false)
-          : mechanics_->evaluate(x, /*with_energy=*/false);
+  // half the elements, the others their images (MembraneMechanics::evaluate_centrally_symmetric), and the load
+  // solved for one node of each pair {i, −i} (LoadSolver::compute_load_centrally_symmetric; not with bending,
+  // whose evaluation factorises the full mass matrix itself).
+  const bool central =
+      central_symmetry_ && mesh::is_centrally_symmetric(*mesh_, x, single_layer_->options().symmetry_tol);
+  membrane::MembraneState s = central ? mechanics_->evaluate_centrally_symmetric(x, /*with_energy=*/false)
+                                      : mechanics_->evaluate(x, /*with_energy=*/false);
   timings_.membrane_s += seconds_since(t0);
   t0 = std::chrono::steady_clock::now();
   // With bending: its evaluation factorises the mass matrix on x (its two mass solves need it), and the
@@ -68,6 +70,8 @@ membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Ei
   try {
     if (bending_)
       load_solver_->solve(s.internal_force + bending_state_.internal_force, q, warm);
+    else if (central)
+      load_solver_->compute_load_centrally_symmetric(x, s.internal_force, q, warm);
     else
       load_solver_->compute_load(x, s.internal_force, q, warm);
   } catch (const std::runtime_error& e) {

@@ -1,5 +1,6 @@
 #include "solver/membrane/load_solver.h"
 
+#include <algorithm>
 #include <array>
 #include <stdexcept>
 #include <string>
@@ -17,6 +18,8 @@ namespace capsim::membrane {
 struct LoadSolver::Impl {
   Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> cholmod;
   std::vector<double> inv_diag;                              // Jacobi preconditioner of the CG backend
+  std::vector<double> inv_diag_reduced;                      // the same for the reduced matrix
+  Eigen::Matrix3Xd reduced_rhs, reduced_q;                   // the reduced system's right side and solution
   std::vector<double> r, z, p, t;                            // CG work arrays, node-major (3 per node)
   std::vector<double> local;                                 // element mass matrices of the last assembly
   std::vector<double> partial;                               // CG: per-block partial dot products
@@ -53,12 +56,64 @@ LoadSolver::LoadSolver(const mesh::SurfaceMesh& mesh, Options options)
   if (options_.backend == Backend::Cholmod) {
     impl_->cholmod.analyzePattern(M_);
     if (impl_->cholmod.info() != Eigen::Success) throw std::runtime_error("CHOLMOD: symbolic analysis failed");
+  } else {
+    central_ = mesh::central_elements(mesh);
+    if (!central_.empty()) build_reduced();
+  }
+}
+
+void LoadSolver::build_reduced() {
+  const int n = mesh_.num_nodes();
+  const auto& image = mesh_.central_node;
+  std::vector<int> reduced_of(static_cast<std::size_t>(n));
+  std::vector<double> sign(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i)
+    if (i < image[i]) {
+      reduced_of[i] = reduced_of[image[i]] = static_cast<int>(reduced_node_.size());
+      sign[i] = 1.0;
+      sign[image[i]] = -1.0;
+      reduced_node_.push_back(i);
+    }
+  // Row k of M̃ (node i): Σ_j M_ij q_j with q_j = sign_j q̃_reduced(j). M is stored symmetric, so column i of the
+  // compressed storage is row i.
+  const int nr = static_cast<int>(reduced_node_.size());
+  const int* outer = M_.outerIndexPtr();
+  const int* inner = M_.innerIndexPtr();
+  std::vector<std::vector<std::pair<int, int>>> entries(static_cast<std::size_t>(nr));  // (reduced col, M slot)
+  std::vector<Eigen::Triplet<double>> trip;
+  for (int k = 0; k < nr; ++k) {
+    const int i = reduced_node_[k];
+    for (int e = outer[i]; e < outer[i + 1]; ++e) {
+      entries[k].emplace_back(reduced_of[inner[e]], e);
+      trip.emplace_back(reduced_of[inner[e]], k, 1.0);
+    }
+  }
+  Mr_.resize(nr, nr);
+  Mr_.setFromTriplets(trip.begin(), trip.end());
+  Mr_.makeCompressed();
+  contrib_begin_.assign(static_cast<std::size_t>(Mr_.nonZeros()) + 1, 0);
+  std::vector<std::vector<std::pair<int, double>>> per_slot(static_cast<std::size_t>(Mr_.nonZeros()));
+  for (int k = 0; k < nr; ++k)
+    for (const auto& [l, slot] : entries[k]) {
+      const int* begin = Mr_.innerIndexPtr() + Mr_.outerIndexPtr()[k];
+      const int* end = Mr_.innerIndexPtr() + Mr_.outerIndexPtr()[k + 1];
+      const int s = static_cast<int>(std::lower_bound(begin, end, l) - Mr_.innerIndexPtr());
+      per_slot[s].emplace_back(slot, sign[inner[slot]]);
+    }
+  for (std::size_t s = 0; s < per_slot.size(); ++s) {
+    contrib_begin_[s + 1] = contrib_begin_[s] + static_cast<int>(per_slot[s].size());
+    for (const auto& [slot, sg] : per_slot[s]) {
+      contrib_slot_.push_back(slot);
+      contrib_sign_.push_back(sg);
+    }
   }
 }
 
 LoadSolver::~LoadSolver() = default;
 
-void LoadSolver::assemble(const Eigen::Matrix3Xd& x) {
+void LoadSolver::assemble(const Eigen::Matrix3Xd& x) { assemble_elements(x, nullptr); }
+
+void LoadSolver::assemble_elements(const Eigen::Matrix3Xd& x, const std::vector<int>* elements) {
   if (x.cols() != mesh_.num_nodes()) throw std::invalid_argument("LoadSolver: positions do not match the mesh");
   double* val = M_.valuePtr();
   std::fill(val, val + M_.nonZeros(), 0.0);
@@ -68,8 +123,11 @@ void LoadSolver::assemble(const Eigen::Matrix3Xd& x) {
   // same order as a serial loop, for any thread count.
   std::vector<double>& local = impl_->local;
   local.assign(static_cast<std::size_t>(ne) * 36, 0.0);
+  const int count = elements ? static_cast<int>(elements->size()) : ne;
+  const int* which = elements ? elements->data() : nullptr;
 #pragma omp parallel for schedule(static)
-  for (int e = 0; e < ne; ++e) {
+  for (int k = 0; k < count; ++k) {
+    const int e = which ? which[k] : k;
     const auto& el = mesh_.elements[e];
     double* le = local.data() + static_cast<std::size_t>(e) * 36;
     double X[6][3], C[6][3];
@@ -88,6 +146,17 @@ void LoadSolver::assemble(const Eigen::Matrix3Xd& x) {
     }
     for (int i = 0; i < 6; ++i)
       for (int j = 0; j < i; ++j) le[i * 6 + j] = le[j * 6 + i];
+  }
+  if (which) {
+    // The mass matrix is even under x → −x: an image element's is the element's, its nodes permuted.
+    for (int k = 0; k < count; ++k) {
+      const int e = which[k], p = central_.image[e];
+      const double* from = local.data() + static_cast<std::size_t>(e) * 36;
+      double* to = local.data() + static_cast<std::size_t>(p) * 36;
+      const auto& pi = central_.local[e];
+      for (int i = 0; i < 6; ++i)
+        for (int j = 0; j < 6; ++j) to[pi[i] * 6 + pi[j]] = from[i * 6 + j];
+    }
   }
   for (int e = 0; e < ne; ++e) {
     const int* slot = value_index_.data() + static_cast<std::size_t>(e) * 36;
@@ -131,14 +200,15 @@ void LoadSolver::solve(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, bool warm
         w.residual.row(c).setZero();
       }
     }
-    solve_cg(w.residual, w.correction, reference2);
+    solve_cg(M_, w.inv_diag, w.residual, w.correction, reference2);
     q += w.correction;
   } else {
-    solve_cg(R, q);
+    solve_cg(M_, impl_->inv_diag, R, q);
   }
 }
 
-void LoadSolver::solve_cg(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, const double* reference2) {
+void LoadSolver::solve_cg(const Eigen::SparseMatrix<double>& A, const std::vector<double>& inv_diag,
+                          const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, const double* reference2) {
   // Jacobi-preconditioned CG from a zero guess on the three load components side by side: three independent
   // CGs (each with its own α, β and stopping test |r_c| < tol |R_c|, Eigen's criterion) that share every
   // pass over M. A component that has converged is frozen.
@@ -165,11 +235,11 @@ void LoadSolver::solve_cg(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, const 
   double* part_rr = w.partial.data();           // |r|² per block (and |b|² at the start)
   double* part_rz = part_rr + 3 * nb;           // r·z per block
   double* part_pt = part_rz + 3 * nb;           // p·t per block
-  const double* d = w.inv_diag.data();
+  const double* d = inv_diag.data();
   const double* b = R.data();
-  const int* outer = M_.outerIndexPtr();
-  const int* inner = M_.innerIndexPtr();
-  const double* val = M_.valuePtr();
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  const double* val = A.valuePtr();
   // M is SPD with a condition number bounded independently of h on any valid surface, so CG converges in a
   // few dozen iterations; the cap (twice the unknowns, as Eigen's) is reached only if M is not SPD.
   const int max_iterations = 2 * n;
@@ -304,6 +374,56 @@ void LoadSolver::compute_load(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd&
   assemble(x);
   factorize();
   solve(R, q, warm);
+}
+
+void LoadSolver::compute_load_centrally_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R,
+                                                  Eigen::Matrix3Xd& q, bool warm) {
+  if (central_.empty() || options_.backend != Backend::ConjugateGradient) return compute_load(x, R, q, warm);
+  // Phases: assemble M from half the elements; M̃ and its Jacobi preconditioner; the reduced right side (R, or for
+  // the warm start R − M q0); CG; q from the reduced solution and its negated images.
+  assemble_elements(x, &central_.half);
+  Impl& w = *impl_;
+  const int nr = static_cast<int>(reduced_node_.size());
+  const double* val = M_.valuePtr();
+  double* rv = Mr_.valuePtr();
+  for (Eigen::Index s = 0; s < Mr_.nonZeros(); ++s) {
+    double v = 0.0;
+    for (int c = contrib_begin_[s]; c < contrib_begin_[s + 1]; ++c) v += contrib_sign_[c] * val[contrib_slot_[c]];
+    rv[s] = v;
+  }
+  w.inv_diag_reduced.resize(static_cast<std::size_t>(nr));
+  const Eigen::VectorXd dr = Mr_.diagonal();
+  for (int k = 0; k < nr; ++k) w.inv_diag_reduced[k] = dr[k] > 0.0 ? 1.0 / dr[k] : 1.0;
+  const bool from_guess = warm && q.rows() == 3 && q.cols() == R.cols();
+  w.reduced_rhs.resize(3, nr);
+  double reference2[3] = {0.0, 0.0, 0.0};
+  if (from_guess) w.residual.noalias() = R - q * M_;  // as solve(): M symmetric
+  for (int k = 0; k < nr; ++k) {
+    const int i = reduced_node_[k];
+    if (from_guess)
+      w.reduced_rhs.col(k) = w.residual.col(i);
+    else
+      w.reduced_rhs.col(k) = R.col(i);
+    for (int c = 0; c < 3; ++c) reference2[c] += R(c, i) * R(c, i);
+  }
+  if (from_guess)
+    for (int c = 0; c < 3; ++c)
+      if (reference2[c] == 0.0) {  // a zero component has the solution 0 (as in solve())
+        q.row(c).setZero();
+        w.reduced_rhs.row(c).setZero();
+      }
+  solve_cg(Mr_, w.inv_diag_reduced, w.reduced_rhs, w.reduced_q, from_guess ? reference2 : nullptr);
+  if (!from_guess) q.setZero(3, R.cols());
+  for (int k = 0; k < nr; ++k) {
+    const int i = reduced_node_[k], p = mesh_.central_node[i];
+    if (from_guess) {
+      q.col(i) += w.reduced_q.col(k);
+      q.col(p) = -q.col(i);
+    } else {
+      q.col(i) = w.reduced_q.col(k);
+      q.col(p) = -w.reduced_q.col(k);
+    }
+  }
 }
 
 }  // namespace capsim::membrane

@@ -55,6 +55,15 @@ class LoadSolver {
   void solve(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, bool warm = false);
   /// @brief assemble(x), factorize(), solve(R, q, warm) in one call.
   void compute_load(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, bool warm = false);
+  /// @brief The same for x centrally symmetric and R odd under x → −x (x_P(i) = −x_i, R_P(i) = −R_i to round-off;
+  /// the caller checks — CapsuleFlow with numerics.central_symmetry): q is odd too, so with q_P(i) = −q_i the
+  /// system is solved for one node of each pair {i, P(i)}, the reduced matrix M̃_ij = M_ij − M_i,P(j) (symmetric
+  /// positive definite: M restricted to the odd loads), half the unknowns; element mass matrices are computed for
+  /// half the elements (an element's is its image's, permuted). The residual test is the same relative one (the
+  /// full residual is the reduced one and its negated image). q agrees with compute_load's to the CG tolerance,
+  /// and is exactly odd. CG backend only; otherwise, or without a central map, it is compute_load.
+  void compute_load_centrally_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q,
+                                        bool warm = false);
 
   /// @brief The last assembled mass matrix (lower and upper parts stored).
   [[nodiscard]] const Eigen::SparseMatrix<double>& mass_matrix() const { return M_; }
@@ -62,13 +71,25 @@ class LoadSolver {
   [[nodiscard]] int last_iterations() const { return last_iterations_; }
 
  private:
-  // CG from zero, stopped at |r_c|² < cg_tolerance² · reference2[c] (nullptr: |R_c|²).
-  void solve_cg(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, const double* reference2 = nullptr);
+  // CG on the matrix A with Jacobi preconditioner inv_diag from zero, stopped at |r_c|² < cg_tolerance² ·
+  // reference2[c] (nullptr: |R_c|²).
+  void solve_cg(const Eigen::SparseMatrix<double>& A, const std::vector<double>& inv_diag, const Eigen::Matrix3Xd& R,
+                Eigen::Matrix3Xd& q, const double* reference2 = nullptr);
+  // Element mass matrices (of `elements`, all when null, the others as their images), summed into M.
+  void assemble_elements(const Eigen::Matrix3Xd& x, const std::vector<int>* elements);
+  // The reduced system of compute_load_centrally_symmetric, built once (constructor).
+  void build_reduced();
   struct Impl;
   const mesh::SurfaceMesh& mesh_;
   Options options_;
   Eigen::SparseMatrix<double> M_;
   std::vector<int> value_index_;  // element-major 6×6 → position in M_.valuePtr()
+  mesh::CentralElements central_;  // x → −x on elements (empty: no reduced solve)
+  std::vector<int> reduced_node_;  // reduced unknown → its node (the smaller index of each pair {i, P(i)})
+  Eigen::SparseMatrix<double> Mr_;  // the reduced matrix M̃ (pattern built once)
+  // Each value of M̃ as Σ sign · (value of M): the contributions of slot s are [contrib_begin_[s], contrib_begin_[s+1]).
+  std::vector<int> contrib_begin_, contrib_slot_;
+  std::vector<double> contrib_sign_;
   std::unique_ptr<Impl> impl_;
   int last_iterations_ = 0;
 };

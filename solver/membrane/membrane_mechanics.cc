@@ -50,39 +50,8 @@ MembraneMechanics::MembraneMechanics(const mesh::SurfaceMesh& mesh, const Eigen:
       throw std::invalid_argument("membrane: element " + std::to_string(i / nq) +
                                   " of the reference surface is degenerate");
   }
-  // The elements' images under x → −x, for evaluate_centrally_symmetric: found by their node sets.
-  const int ne = mesh.num_elements();
-  if (static_cast<int>(mesh.central_node.size()) == mesh.num_nodes() && ne > 0) {
-    std::map<std::array<int, 6>, int> by_nodes;
-    for (int e = 0; e < ne; ++e) {
-      auto key = mesh.elements[e];
-      std::sort(key.begin(), key.end());
-      by_nodes.emplace(key, e);
-    }
-    std::vector<int> image(static_cast<std::size_t>(ne), -1);
-    std::vector<std::array<int, 6>> local(static_cast<std::size_t>(ne));
-    bool complete = true;
-    for (int e = 0; e < ne && complete; ++e) {
-      std::array<int, 6> key{};
-      for (int a = 0; a < 6; ++a) key[a] = mesh.central_node[mesh.elements[e][a]];
-      std::sort(key.begin(), key.end());
-      const auto it = by_nodes.find(key);
-      if (it == by_nodes.end() || it->second == e) {
-        complete = false;
-        break;
-      }
-      image[e] = it->second;
-      const auto& to = mesh.elements[it->second];
-      for (int a = 0; a < 6; ++a)
-        local[e][a] = static_cast<int>(std::find(to.begin(), to.end(), mesh.central_node[mesh.elements[e][a]]) - to.begin());
-    }
-    if (complete) {
-      central_element_ = std::move(image);
-      central_local_ = std::move(local);
-      for (int e = 0; e < ne; ++e)
-        if (e < central_element_[e]) central_half_.push_back(e);
-    }
-  }
+  // The elements' images under x → −x, for evaluate_centrally_symmetric.
+  central_ = mesh::central_elements(mesh);
 }
 
 namespace {
@@ -151,7 +120,7 @@ MembraneState MembraneMechanics::evaluate(const Eigen::Matrix3Xd& x, bool with_e
 }
 
 MembraneState MembraneMechanics::evaluate_centrally_symmetric(const Eigen::Matrix3Xd& x, bool with_energy) const {
-  return evaluate_elements(x, with_energy, central_half_.empty() ? nullptr : &central_half_);
+  return evaluate_elements(x, with_energy, central_.empty() ? nullptr : &central_.half);
 }
 
 MembraneState MembraneMechanics::evaluate_elements(const Eigen::Matrix3Xd& x, bool with_energy,
@@ -210,11 +179,11 @@ MembraneState MembraneMechanics::evaluate_elements(const Eigen::Matrix3Xd& x, bo
     // The image of each evaluated element: R is odd under x → −x, so its forces are the negated ones on the
     // image nodes; energy and tension extremes are the same.
     for (int k = 0; k < count; ++k) {
-      const int e = which[k], p = central_element_[e];
+      const int e = which[k], p = central_.image[e];
       const double* from = force.data() + static_cast<std::size_t>(e) * 18;
       double* to = force.data() + static_cast<std::size_t>(p) * 18;
       for (int a = 0; a < 6; ++a)
-        for (int c = 0; c < 3; ++c) to[3 * central_local_[e][a] + c] = -from[3 * a + c];
+        for (int c = 0; c < 3; ++c) to[3 * central_.local[e][a] + c] = -from[3 * a + c];
       energy[p] = energy[e];
       lo[p] = lo[e];
       hi[p] = hi[e];

@@ -66,7 +66,7 @@ class MembraneMechanics {
   [[nodiscard]] MembraneState evaluate_centrally_symmetric(const Eigen::Matrix3Xd& x, bool with_energy = true) const;
   /// @brief Whether evaluate_centrally_symmetric can use the symmetry (the mesh has a central map that maps
   /// elements onto elements).
-  [[nodiscard]] bool has_central_map() const { return !central_element_.empty(); }
+  [[nodiscard]] bool has_central_map() const { return !central_.empty(); }
 
   /// @brief Elastic energy W only (for finite-difference checks).
   [[nodiscard]] double energy(const Eigen::Matrix3Xd& x) const;
@@ -94,11 +94,7 @@ class MembraneMechanics {
   const MembraneLaw& law_;
   mesh::P2Tabulation p2_;                                  // the rule's points
   std::vector<RefPoint> ref_;                              // element-major, per rule point
-  // x → −x on elements (mesh.central_node; empty if none): the image element of each element, the local
-  // index in it of the image of each local node, and one element of each pair (the smaller index).
-  std::vector<int> central_element_;
-  std::vector<std::array<int, 6>> central_local_;
-  std::vector<int> central_half_;
+  mesh::CentralElements central_;                         // x → −x on elements (empty if the mesh has no map)
 };
 
 /// @brief Surface area ∫_S dS and enclosed volume (1/3)∫_S x·n dS of positions x on the exact P2 geometry.

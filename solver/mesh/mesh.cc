@@ -303,6 +303,37 @@ bool is_mirror_symmetric(const SurfaceMesh& m, const Eigen::Matrix3Xd& x, double
   return x.cols() > 0 && symmetric_under(m.mirror_node, kMirrorSigns, x, relative_to_extent(x, tol));
 }
 
+CentralElements central_elements(const SurfaceMesh& m) {
+  CentralElements out;
+  const int ne = m.num_elements();
+  if (static_cast<int>(m.central_node.size()) != m.num_nodes() || ne == 0) return out;
+  // Elements are found by their node sets.
+  std::map<std::array<int, 6>, int> by_nodes;
+  for (int e = 0; e < ne; ++e) {
+    auto key = m.elements[e];
+    std::sort(key.begin(), key.end());
+    by_nodes.emplace(key, e);
+  }
+  std::vector<int> image(static_cast<std::size_t>(ne), -1);
+  std::vector<std::array<int, 6>> local(static_cast<std::size_t>(ne));
+  for (int e = 0; e < ne; ++e) {
+    std::array<int, 6> key{};
+    for (int a = 0; a < 6; ++a) key[a] = m.central_node[m.elements[e][a]];
+    std::sort(key.begin(), key.end());
+    const auto it = by_nodes.find(key);
+    if (it == by_nodes.end() || it->second == e) return out;
+    image[e] = it->second;
+    const auto& to = m.elements[it->second];
+    for (int a = 0; a < 6; ++a)
+      local[e][a] = static_cast<int>(std::find(to.begin(), to.end(), m.central_node[m.elements[e][a]]) - to.begin());
+  }
+  out.image = std::move(image);
+  out.local = std::move(local);
+  for (int e = 0; e < ne; ++e)
+    if (e < out.image[e]) out.half.push_back(e);
+  return out;
+}
+
 bool is_centrally_symmetric(const SurfaceMesh& m, const Eigen::Matrix3Xd& x, double tol) {
   return x.cols() > 0 && symmetric_under(m.central_node, kCentralSigns, x, relative_to_extent(x, tol));
 }

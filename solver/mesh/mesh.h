@@ -111,6 +111,19 @@ bool symmetric_under(std::span<const int> image, const std::array<double, 3>& si
 bool is_mirror_symmetric(const SurfaceMesh& m, const Eigen::Matrix3Xd& x, double tol);
 
 
+/// @brief The point reflection x → −x on elements: each element's image element (the element whose nodes are the
+/// images of its nodes) and where each local node's image sits in it; `half` lists one element of each pair (the
+/// smaller index). Used to compute per-element quantities that are odd or even under x → −x (membrane forces,
+/// element mass matrices) on half the elements. Empty if the mesh has no central map or an element is its own
+/// image (never for a closed surface about the origin).
+struct CentralElements {
+  std::vector<int> image;
+  std::vector<std::array<int, 6>> local;
+  std::vector<int> half;
+  [[nodiscard]] bool empty() const { return image.empty(); }
+};
+CentralElements central_elements(const SurfaceMesh& m);
+
 /// @brief Whether x is centrally symmetric, x_central(i) = −x_i for every node, to `tol` relative to the
 /// extent of x; false if the mesh has no central map.
 bool is_centrally_symmetric(const SurfaceMesh& m, const Eigen::Matrix3Xd& x, double tol);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <filesystem>
 #include <cstdio>
 #include <numbers>
@@ -360,54 +361,42 @@ void expect_same_case_and_bitwise_resume(const config::CaseConfig& base, const c
   EXPECT_TRUE(io::read_case_file(rdir / "case.h5").series == series) << name;
 }
 
-// numerics.load_warm_start carries the previous stage's load into the next solve, but never across a step
-// (CapsuleFlow::begin_step): a run interrupted between steps and resumed repeats the uninterrupted one bitwise.
-// Its answers stay those of the cold solve to far below the time-step error.
-TEST(CaseDriver, WarmStartedLoadSolvesResumeBitwise) {
+// expect_same_case_and_bitwise_resume for an option on an oblate level-2 case (Ca 0.05, γ̇t ≤ 0.6) and on a level-1 case
+// with bending stiffness (κ_b = 1e-2, γ̇t ≤ 0.3), whose load is solved on the mass matrix the bending evaluation
+// factorised (another path through LoadSolver).
+void expect_option_keeps_the_case(const std::string& law, const std::function<void(config::CaseConfig&)>& set_option,
+                                  const std::string& name, double bound) {
   config::CaseConfig c;
   c.aspect_ratio = 0.5;
-  c.law = "neo-hookean";
+  c.law = law;
   c.capillary_number = 0.05;
   c.level = 2;
   c.t_end = 0.6;
-  config::CaseConfig warm = c;
-  warm.load_warm_start = true;
-  // D12 within the load tolerance's reach.
-  expect_same_case_and_bitwise_resume(c, warm, "warm", 1e-9);
-
-  // With bending stiffness the load is solved on the mass matrix the bending evaluation factorised (another
-  // path through LoadSolver): the warm start must agree with the cold solve there too, and resume bitwise.
-  c.level = 1;
-  c.t_end = 0.3;
-  c.bending_modulus = 1e-2;
-  warm = c;
-  warm.load_warm_start = true;
-  expect_same_case_and_bitwise_resume(c, warm, "warm_bending", 1e-9);
+  for (const bool bending : {false, true}) {
+    if (bending) {
+      c.level = 1;
+      c.t_end = 0.3;
+      c.bending_modulus = 1e-2;
+    }
+    config::CaseConfig variant = c;
+    set_option(variant);
+    expect_same_case_and_bitwise_resume(c, variant, name + (bending ? "_bending" : ""), bound);
+  }
 }
 
-// numerics.central_symmetry: the same case as without it (in double the operator is the same to round-off, so
-// D12 agrees to round-off over the run), and a run interrupted halfway resumes bitwise — its
-// checkpoint holds the symmetrised state, from which the driver decides the same way.
-TEST(CaseDriver, CentralSymmetryGivesTheSameCaseAndResumesBitwise) {
-  config::CaseConfig c;
-  c.aspect_ratio = 0.5;
-  c.law = "skalak";
-  c.capillary_number = 0.05;
-  c.level = 2;
-  c.t_end = 0.6;
-  config::CaseConfig central = c;
-  central.central_symmetry = true;
-  // Double precision: the two operators differ by round-off (1e-14 of u), grown over 30 steps.
-  expect_same_case_and_bitwise_resume(c, central, "central", 1e-11);
+// numerics.load_warm_start carries the previous stage's load into the next solve, but never across a step
+// (CapsuleFlow::begin_step): a run interrupted between steps and resumed repeats the uninterrupted one bitwise.
+// Its answers stay those of the cold solve to far below the time-step error: D12 within the load tolerance's reach.
+TEST(CaseDriver, WarmStartedLoadSolvesResumeBitwise) {
+  expect_option_keeps_the_case("neo-hookean", [](config::CaseConfig& c) { c.load_warm_start = true; }, "warm", 1e-9);
+}
 
-  // With bending stiffness: the membrane and the boundary integral use the symmetry, the bending evaluation and
-  // its load solve (on the mass matrix it factorised) the full mesh.
-  c.level = 1;
-  c.t_end = 0.3;
-  c.bending_modulus = 1e-2;
-  central = c;
-  central.central_symmetry = true;
-  expect_same_case_and_bitwise_resume(c, central, "central_bending", 1e-11);
+// numerics.central_symmetry: the same case as without it — in double the operator is the same to round-off (1e-14
+// of u), so D12 agrees to round-off over the run; with bending the membrane and the boundary integral use the
+// symmetry, the bending evaluation and its load solve the full mesh — and a run interrupted halfway resumes
+// bitwise: its checkpoint holds the symmetrised state, from which the driver decides the same way.
+TEST(CaseDriver, CentralSymmetryGivesTheSameCaseAndResumesBitwise) {
+  expect_option_keeps_the_case("skalak", [](config::CaseConfig& c) { c.central_symmetry = true; }, "central", 1e-11);
 }
 
 }  // namespace

@@ -36,7 +36,6 @@ CapsuleFlow::CapsuleFlow(const config::CaseConfig& c) : Ca_(c.capillary_number) 
   so.far_radius = c.far_radius;
   so.precision = c.kernel_precision == "mixed" ? stokes::KernelPrecision::Mixed : stokes::KernelPrecision::Double;
   so.central_symmetry = c.central_symmetry;
-  central_symmetry_ = c.central_symmetry;
   single_layer_ = std::make_unique<stokes::SingleLayer>(*mesh_, so);
   volume_correction_ = c.volume_correction;
   flux_rule_ = mesh::P2Tabulation::of_degree(6);
@@ -54,8 +53,8 @@ membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Ei
   // half the elements, the others their images (MembraneMechanics::evaluate_centrally_symmetric), and the load
   // solved for one node of each pair {i, −i} (LoadSolver::compute_load_centrally_symmetric; not with bending,
   // whose evaluation factorises the full mass matrix itself).
-  const bool central =
-      central_symmetry_ && mesh::is_centrally_symmetric(*mesh_, x, single_layer_->options().symmetry_tol);
+  const stokes::SingleLayerOptions& so = single_layer_->options();
+  const bool central = so.central_symmetry && mesh::is_centrally_symmetric(*mesh_, x, so.symmetry_tol);
   membrane::MembraneState s = central ? mechanics_->evaluate_centrally_symmetric(x, /*with_energy=*/false)
                                       : mechanics_->evaluate(x, /*with_energy=*/false);
   timings_.membrane_s += seconds_since(t0);

@@ -110,7 +110,6 @@ class CapsuleFlow {
   std::unique_ptr<stokes::SingleLayer> single_layer_;
   Eigen::Matrix3Xd q_, u_;
   bool load_warm_start_ = false;  // numerics.load_warm_start
-  bool central_symmetry_ = false;  // numerics.central_symmetry (the boundary integral has its own copy)
   bool load_guess_ = false;       // q_ is the load of a successful evaluation since the last begin_step()
   FlowTimings timings_;
   bool background_flow_ = true;

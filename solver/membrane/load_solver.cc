@@ -404,7 +404,8 @@ void LoadSolver::compute_load_centrally_symmetric(const Eigen::Matrix3Xd& x, con
       w.reduced_rhs.col(k) = w.residual.col(i);
     else
       w.reduced_rhs.col(k) = R.col(i);
-    for (int c = 0; c < 3; ++c) reference2[c] += R(c, i) * R(c, i);
+    if (from_guess)  // the warm start's stopping reference |R_c|² (a cold solve takes it from its right side)
+      for (int c = 0; c < 3; ++c) reference2[c] += R(c, i) * R(c, i);
   }
   if (from_guess)
     for (int c = 0; c < 3; ++c)

@@ -26,6 +26,14 @@ ca_tolerance = 0.005
 max_rounds = 20
 )";
 
+// The two-cell campaign of the cell-scheduling tests: a prolate NH cell sampled at `prolate_ca` and the oblate grid,
+// scan level 1, answer level 2, with the dt check; and the fake worker's fast settings for it.
+std::string two_cell_spec(const std::string& prolate_ca) {
+  return "[campaign]\nname = \"mf\"\n[[grid]]\naspect_ratio = [2.0]\nlaw = [\"neo-hookean\"]\ncapillary_number = [" +
+         prolate_ca + "]\n" + kOblateGrid + "levels = [1, 2]\ndt_check = true\n";
+}
+const std::string kTwoCellEnv = "FAKE_STEPS=1 FAKE_STEP_S=0.001 FAKE_LEVEL_SHIFT=0.08";
+
 TEST(MultiFidelity, ScanAnswerCheckAndTheErrorBarOfCaH) {
   const std::string dir = fresh_dir("multi_fidelity");
   const std::string db = dir + "/study.db";
@@ -207,12 +215,8 @@ TEST(MultiFidelity, AFreeWorkerTakesTheCheckLevelsNextCaseWhileALongOneRuns) {
 // with the same cases and the same Table 1 as a run without the slow case, and as one with a single worker.
 TEST(MultiFidelity, ACellTakesItsNextRoundWhileAnotherCellsCasesRun) {
   const std::string dir = fresh_dir("multi_fidelity_cells");
-  write_file(dir + "/mf.toml", "[campaign]\nname = \"mf\"\n" + std::string(R"([[grid]]
-aspect_ratio = [2.0]
-law = ["neo-hookean"]
-capillary_number = [0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.6]
-)") + kOblateGrid + "levels = [1, 2]\ndt_check = true\n");
-  const std::string env = "FAKE_STEPS=1 FAKE_STEP_S=0.001 FAKE_LEVEL_SHIFT=0.08";
+  write_file(dir + "/mf.toml", two_cell_spec("0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.6"));
+  const std::string& env = kTwoCellEnv;
   auto cases = [&](const std::string& db) {
     return sql(db, "SELECT aspect_ratio, mesh_level, capillary_number, params_json FROM cases "
                    "ORDER BY aspect_ratio, mesh_level, capillary_number, params_json");
@@ -254,13 +258,9 @@ capillary_number = [0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.6]
 // one worker: the oblate cell has the most scan work, the prolate one the single longest scan case (Ca 0.005).
 TEST(MultiFidelity, ACellsRoundRunsAsOneBlockTheCellWithTheMostQueuedWorkFirst) {
   const std::string dir = fresh_dir("multi_fidelity_cell_blocks");
-  write_file(dir + "/mf.toml", "[campaign]\nname = \"mf\"\n" + std::string(R"([[grid]]
-aspect_ratio = [2.0]
-law = ["neo-hookean"]
-capillary_number = [0.005, 0.15, 0.2, 0.3, 0.6]
-)") + kOblateGrid + "levels = [1, 2]\ndt_check = true\n");
+  write_file(dir + "/mf.toml", two_cell_spec("0.005, 0.15, 0.2, 0.3, 0.6"));
   const std::string db = dir + "/one.db";
-  auto r = sh(campaign_cmd("FAKE_STEPS=1 FAKE_STEP_S=0.001 FAKE_LEVEL_SHIFT=0.08", dir + "/mf.toml", db, "--jobs 1"));
+  auto r = sh(campaign_cmd(kTwoCellEnv, dir + "/mf.toml", db, "--jobs 1"));
   ASSERT_EQ(r.code, 0) << r.err;
   ASSERT_NE(r.err.find(", while "), std::string::npos)
       << "a cell took a round while the other's cases waited: " << r.err;

@@ -1,4 +1,4 @@
--- capsim campaign database, schema version 3: transitions keyed by group (issue 12, defect 8).
+-- capsim campaign database, schema version 3: transitions keyed by group.
 -- A transition is computed per group of cases that agree in every identity key except Ca; a grid axis over
 -- any key (time.dt, numerics.*) makes several groups with the same law, a/b, C and level, so the key of a
 -- row is its group_key: the canonical JSON object of those identity keys (the solver's resolved values, as in

@@ -1,4 +1,4 @@
--- capsim campaign database, schema version 4: the numerical uncertainty of every answer (issue 14).
+-- capsim campaign database, schema version 4: the numerical uncertainty of every answer.
 -- Each transition row says what its group is for in its cell (role) and carries the error of each answer in
 -- Ca, the part that dominates it and how it was obtained (campaign/analysis/uncertainty.h). Columns are
 -- added in place: rows of version 3 read as role 'answer' without errors until the campaign is analysed again.

@@ -1,4 +1,4 @@
--- capsim campaign database, schema version 6: which parts of each answer's error had no data (issue 14 §1).
+-- capsim campaign database, schema version 6: which parts of each answer's error had no data.
 -- An error is the largest of its mesh, periods and dt parts (campaign/analysis/uncertainty.h); a part without
 -- data (one mesh level, no dt check, periods not recorded) is left out, so the error is then a lower bound.
 -- Until now only error_note said so, and `capsim query table1` printed such an error like a complete one.

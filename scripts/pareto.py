@@ -1,4 +1,4 @@
-"""Run time against error for the two reference problems of issue 6 (see scripts/pareto).
+"""Run time against error for the two reference problems (see scripts/pareto).
 
 (a) sphere, Skalak C = 1, Ca = 0.3: the steady Taylor parameter D12 (interpolated at γ̇t = 5.9; the table
     gives the remaining drift |dD12/dt| over γ̇t ∈ [5, 5.9], which bounds how far from steady it still is);

@@ -1,4 +1,4 @@
-"""Flow evaluations per unit of simulated time against time-step error (issue 13 §2; see scripts/step_study).
+"""Flow evaluations per unit of simulated time against time-step error (see scripts/step_study).
 
 Three reference cases, mesh level 3, shear flow from rest, γ̇t ∈ [0, 4]:
   (a) oblate a/b = 0.5, neo-Hookean, Ca = 0.02   (stiff: RKC with many stages)

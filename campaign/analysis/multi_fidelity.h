@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief Multi-fidelity campaigns (issue 14 §2): which cases the answer and check levels need, from what the
+/// @brief Multi-fidelity campaigns: which cases the answer and check levels need, from what the
 /// other levels found. Pure: the scheduler adds the returned cases and runs them (campaign_runner.cc).
 ///
 /// The phases, for [analysis] levels = [scan, answer(, check)]:
@@ -61,7 +61,7 @@ std::vector<CaseParams> answer_level_round(const std::vector<SampleGroup>& group
 
 /// @brief The bisections adaptive refinement did not make because it stopped at the numerical error: for each
 /// bracket of @p t (both Ca* edges, CaH) that is wider than @p ca_tolerance, ceil(log2(width / ca_tolerance))
-/// — the cases a refinement down to ca_tolerance alone would still have run (issue 14 §2, "report the cases
+/// — the cases a refinement down to ca_tolerance alone would still have run ("report the cases
 /// saved"). 0 for a missing bracket.
 int bisections_saved(const Transition& t, double ca_tolerance);
 
@@ -74,7 +74,7 @@ std::vector<CaseParams> check_level_cases(const std::vector<SampleGroup>& groups
 /// free): only with a check level, and only while every unfinished case — running or queued — is a
 /// check-level one (@p unfinished_levels: their mesh levels). Why: the rounds are sequential, so one
 /// check-level case of hours kept every other worker idle until it ended, while the answer level and other
-/// cells had work waiting (the certified Table 1, 2026-12-05: four level-3 refinements and the check level of
+/// cells had work waiting (seen in the certified Table 1: four level-3 refinements and the check level of
 /// other cells behind one level-4 case); and a queue of check-level cases (17 of them, ≈ 36 core-hours) kept
 /// the check case a finished one had just called for (Sk a/b 0.5 at 2.561) behind all of them. An unfinished
 /// answer-level case may still move a bracket, so then nothing; a check-level case changes at most its own

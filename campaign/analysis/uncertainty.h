@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief The numerical uncertainty of every Table 1 answer (issue 14 §1): Ca* edges and CaH with an error
+/// @brief The numerical uncertainty of every Table 1 answer: Ca* edges and CaH with an error
 /// in Ca, the source that dominates it, and how it was obtained. Pure computation on the grouped cases.
 ///
 /// A *cell* is the set of groups that differ only in `mesh.level` and `time.dt` (one law, a/b, C and

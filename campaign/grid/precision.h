@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief Numbers of the printed tables to the precision their numerical error supports (issue 12 §3): a
+/// @brief Numbers of the printed tables to the precision their numerical error supports: a
 /// sampled Ca as sampled (shortest decimal), an interpolated value rounded to the leading digit of its error
 /// (for CaH: the width of its bracket), a diagnostic (min D12, max tau_min) to 3 significant digits. Until
 /// error estimates exist these are the supportable precisions; with them, format_plus_minus. JSON output keeps full precision.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief Indicators of membrane wrinkling and mesh-scale noise (issue 6 stress tests).
+/// @brief Indicators of membrane wrinkling and mesh-scale noise.
 ///
 /// A capsule membrane without bending stiffness cannot carry compression: where the smaller principal
 /// tension τ2 is negative the continuum problem is ill posed and the discrete one buckles at the mesh scale

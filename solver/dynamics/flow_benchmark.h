@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// @brief The cost of one flow evaluation by named phase, measured beside the bare regular Stokeslet sum over
-/// the same targets and sources in the same run (issue 13 §1; `capsim bench flow`).
+/// the same targets and sources in the same run (`capsim bench flow`).
 ///
 /// The regular sum is the irreducible part of an evaluation: every target against every quadrature point,
 /// O(N²). Everything else (point layout, the singular and near-singular corrections, the membrane, the load

@@ -22,7 +22,7 @@ struct Column {
   const char* name;
   const char* units;
   std::vector<double> diagnostics::TimeSeries::*member;
-  bool optional = false;  // added later (issue 15): a file without it reads as zeros
+  bool optional = false;  // added later: a file without it reads as zeros
 };
 constexpr Column kColumns[] = {
     {"t", "1/shear_rate", &diagnostics::TimeSeries::t},

@@ -21,7 +21,7 @@ constexpr auto kFixed = h5::StringStorage::Fixed;
 struct Column {
   const char* name;
   std::vector<double> diagnostics::TimeSeries::*member;
-  bool optional = false;  // added later (issue 15): a checkpoint without it reads as zeros, hashed without it
+  bool optional = false;  // added later: a checkpoint without it reads as zeros, hashed without it
 };
 constexpr Column kColumns[] = {
     {"t", &diagnostics::TimeSeries::t},           {"D12", &diagnostics::TimeSeries::D12},

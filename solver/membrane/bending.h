@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief Bending stiffness of the capsule membrane (issue 15, solver/README.md §2.4): a Helfrich energy
+/// @brief Bending stiffness of the capsule membrane (solver/README.md §2.4): a Helfrich energy
 /// measured against the reference curvature, on the P2 surface, with its exact discrete gradient.
 ///
 /// **Continuum model.** With c = κ1 + κ2 the total curvature (2/R on a sphere of radius R, outward normal)

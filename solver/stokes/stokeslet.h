@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief Stokeslet sums, the hot loop of the boundary-integral flow (solver/README.md §3, issue 6 §1).
+/// @brief Stokeslet sums, the hot loop of the boundary-integral flow (solver/README.md §3).
 ///
 /// For targets x0_i and sources (x_j, w_j) this computes, for every target,
 ///     u_i = Σ_j J(x0_i, x_j) · w_j,     J = I/r + r r/r³,  r = x0_i − x_j,

@@ -1,5 +1,5 @@
 // One flow evaluation timed with any build of the solver library, for before/after comparisons of the
-// per-evaluation cost (issue 13 §1): scripts/bench-eval-ab compiles this file against two builds' solver
+// per-evaluation cost: scripts/bench-eval-ab compiles this file against two builds' solver
 // libraries and runs them alternately. It uses only the API that existed before `capsim bench flow`
 // (CapsuleFlow, SingleLayer::build_sources, kernel::sum_fast), so it compiles against older commits.
 //

@@ -1,4 +1,4 @@
-// Boundary-integral flow benchmarks (issue 3 "Benchmark", issue 6 §1): the full single-layer evaluation at
+// Boundary-integral flow benchmarks: the full single-layer evaluation at
 // levels 2, 3, 4 next to the same evaluation with the plain reference loop, and the bare Stokeslet sums
 // (fast kernel variants and plain loop) in the same run. items_per_second = Stokeslet interactions/s.
 // After the Google benchmarks, a far-field-tier table (SingleLayerOptions::far_degree / far_radius): wall

@@ -1,4 +1,4 @@
-// Issue 12, defect 8: transitions are computed per group of cases that agree in every identity key but Ca.
+// Transitions are computed per group of cases that agree in every identity key but Ca.
 // A grid axis over a numerical key (here time.dt) must give one Ca* / CaH per value, not a pooled one.
 #include <gtest/gtest.h>
 
@@ -38,7 +38,7 @@ TEST(TransitionGroups, NumericsAxisGivesOneTransitionPerValue) {
   EXPECT_NE(q.err.find("time.dt"), std::string::npos) << q.err;
 }
 
-// A bending axis (issue 15: Table 1 at several κ_b in one campaign): query table1 names the option that picks
+// A bending axis (Table 1 at several κ_b in one campaign): query table1 names the option that picks
 // one κ_b, and with it prints that κ_b's table, headed by its value.
 TEST(TransitionGroups, BendingAxisIsChosenWithBendingModulus) {
   const std::string dir = fresh_dir("transition_groups_bending");

@@ -44,7 +44,7 @@ TEST(Transitions, CaStarIsTheSampledIntervalBelowThreshold) {
 }
 
 // The notes are printed (campaign status, the main command): numbers to 3 significant digits and sampled Ca as
-// sampled, never the 17 digits of a double (issue 12 §3).
+// sampled, never the 17 digits of a double.
 TEST(Transitions, NotesPrintNumbersToTheirPrecision) {
   std::vector<Sample> s = {sample(0.4, 0.44971266940321575, 0.01, "a"), sample(0.5, 0.49025674011763399, -0.01, "b")};
   const Transition t = analyse_group(Transition{}, s, 0.05);

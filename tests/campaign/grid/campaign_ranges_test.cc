@@ -1,4 +1,4 @@
-// A campaign checks every case key against the same range as a case file (issue 12: duffy_order was
+// A campaign checks every case key against the same range as a case file (duffy_order was once
 // 2..64 in a case file but unchecked in a campaign grid), when the campaign file is parsed, with the
 // campaign's "FILE: KEY: problem" message.
 #include <string>

@@ -125,7 +125,7 @@ TEST(Identity, StableAndSensitiveToWhatMatters) {
   explicit_default.set("time.dt_factor", 0.25);
   explicit_default.set("numerics.regular_degree", std::int64_t{4});
   EXPECT_EQ(explicit_default.identity("abc"), p.identity("abc"));
-  // A key added later (capsule.bending_modulus, issue 15) at its default is not in the identity at all:
+  // A key added later (capsule.bending_modulus) at its default is not in the identity at all:
   // every case stored before it keeps its identity (committed_identity_test checks the databases).
   explicit_default.set("capsule.bending_modulus", 0.0);
   EXPECT_EQ(explicit_default.identity("abc"), p.identity("abc"));

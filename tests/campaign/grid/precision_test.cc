@@ -1,4 +1,4 @@
-// Printed numbers carry the digits their error supports (issue 12 §3): sampled values as sampled,
+// Printed numbers carry the digits their error supports: sampled values as sampled,
 // interpolated values to the leading digit of their error, diagnostics to 3 significant digits.
 #include <gtest/gtest.h>
 

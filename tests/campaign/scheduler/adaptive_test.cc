@@ -55,7 +55,7 @@ max_rounds = 20
   EXPECT_EQ(again[0]["n_samples"].get<int>(), n);
 }
 
-// Issue 12, defect 6: a round reported the Ca values it proposed, also those whose case already exists (here an
+// A round once reported the Ca values it proposed, also those whose case already exists (here an
 // unstable case at Ca = 0.15 is proposed again every round: it is no sample, yet its identity exists). The
 // reported counts must add up to the adaptive cases the database holds.
 TEST(Adaptive, RoundsReportTheCasesTheyAdded) {

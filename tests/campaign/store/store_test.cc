@@ -120,7 +120,7 @@ TEST(Store, QueryCasesGivesTheCostAndTheKeysOfEachCase) {
   }
 }
 
-// A database written under an earlier cost estimator (est_cost ∝ 1/Ca before 2026-12-05) is ordered by
+// A database written under an earlier cost estimator (an est_cost ∝ 1/Ca) is ordered by
 // today's once a campaign run opens it: every case's est_cost becomes CaseParams::estimated_cost.
 TEST(Store, ARunRefreshesTheCostEstimatesOfItsCases) {
   const std::string dir = fresh_dir("store_refresh_estimates");

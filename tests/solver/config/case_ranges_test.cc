@@ -1,4 +1,4 @@
-// Every numeric case key is bounded (issue 12, defect 10): an absurd value is a typing error, rejected
+// Every numeric case key is bounded: an absurd value is a typing error, rejected
 // with one message naming the key before anything runs, and an integer is range-checked as the 64-bit
 // value TOML gives, before anything narrows it to int.
 #include <string>

@@ -226,7 +226,7 @@ PeriodOptions final_analysis() {
   return o;
 }
 
-// Issue 12 §3: a tank-treading sphere whose shape is stationary to ~1e-3 while τmin, a pointwise minimum
+// A tank-treading sphere whose shape is stationary to ~1e-3 while τmin, a pointwise minimum
 // over a wrinkling membrane, flickers by a few 1e-2. The settled rule (spread of D12 ≤ 1e-4) never calls
 // it steady; the final analysis must report it steady, with D12, θ and the statistics of τmin over the
 // window — and the march's analysis must not (a stop needs a settled shape).

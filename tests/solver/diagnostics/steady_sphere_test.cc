@@ -1,4 +1,4 @@
-// A real run of an initially spherical capsule (issue 12 §3): it reaches a steady, tank-treading shape and
+// A real run of an initially spherical capsule: it reaches a steady, tank-treading shape and
 // the analysis must say so (regime `steady`, finite D12, θ and τmin statistics) when the run ends, even
 // where the wrinkles keep the shape from settling enough to stop it early.
 #include <cmath>

@@ -280,7 +280,7 @@ TEST(CaseDriver, OutputFolderThatCannotBeCreatedIsAnIoError) {
   }
 }
 
-// Bending stiffness (issue 15) through the driver: the compressed oblate capsule with a stiff bending
+// Bending stiffness through the driver: the compressed oblate capsule with a stiff bending
 // modulus ends done with finite values, the time series carries the bending energy and moment, the stage
 // count follows the stiffness, and an interrupted run resumes bitwise onto the uninterrupted one.
 TEST(CaseDriver, BendingRunIsStableRecordedAndResumesBitwise) {

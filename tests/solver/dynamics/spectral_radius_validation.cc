@@ -60,7 +60,7 @@ TEST_P(SpectralRadiusAlongRuns, EstimateBoundsThePowerIteration) {
 }
 
 INSTANTIATE_TEST_SUITE_P(
-    Issue13Cases, SpectralRadiusAlongRuns,
+    ReferenceCases, SpectralRadiusAlongRuns,
     testing::Combine(testing::Values(Case{"a: NH a/b 0.5 Ca 0.02", "neo-hookean", 0.5, 0.02},
                                      Case{"b: Sk a/b 2 Ca 0.1", "skalak", 2.0, 0.1},
                                      Case{"c: Sk a/b 2 Ca 0.9", "skalak", 2.0, 0.9}),
@@ -69,7 +69,7 @@ INSTANTIATE_TEST_SUITE_P(
       return std::string(1, std::get<0>(info.param).name[0]) + "_level" + std::to_string(std::get<1>(info.param));
     });
 
-// Bending stiffness (issue 15): the rate κ_b/(Ca h³) of the shortest bending modes. At the reference shape
+// Bending stiffness: the rate κ_b/(Ca h³) of the shortest bending modes. At the reference shape
 // (no prestress), levels 2 and 3, κ_b from where bending is negligible to where it dominates; prints the
 // fitted constant ρ Ca h³/κ_b − (elastic part) and asserts the estimate bounds the power iteration.
 class BendingSpectralRadius : public testing::TestWithParam<std::tuple<double, int>> {};
@@ -99,7 +99,7 @@ TEST_P(BendingSpectralRadius, EstimateBoundsThePowerIteration) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Issue15, BendingSpectralRadius,
+INSTANTIATE_TEST_SUITE_P(Bending, BendingSpectralRadius,
                          testing::Combine(testing::Values(1e-3, 1e-2, 1e-1), testing::Values(2, 3, 4)));
 
 }  // namespace

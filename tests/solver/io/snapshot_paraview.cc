@@ -1,4 +1,4 @@
-// ParaView's own XDMF reader opens a snapshot file written by `capsim run` (issue 12 §3): a small case with
+// ParaView's own XDMF reader opens a snapshot file written by `capsim run`: a small case with
 // snapshots, then pvbatch on tests/solver/io/open_snapshots.py, which checks the time steps, points, cells
 // and point arrays (q_n, q, velocity, tau_min, tau_max) against case.h5 and renders one image offscreen.
 // Label `paraview` (not in the default suite): needs `pvbatch`, and `xvfb-run` where there is no $DISPLAY

@@ -358,7 +358,7 @@ TEST(MembraneMechanics, TauMinIsTheSmallerTensionWhenSkalakReversesTheOrder) {
   EXPECT_EQ(unordered, 0);
 }
 
-// Defect 3 of issue 12: the CG backend never looked at its convergence, so a degenerate surface (a NaN
+// The CG backend once never looked at its convergence, so a degenerate surface (a NaN
 // position, a surface collapsed to a point: the mass matrix is NaN or zero) gave a NaN or garbage load
 // silently instead of DegenerateSurface, which the driver turns into an `unstable` outcome.
 TEST(LoadSolver, DegenerateSurfaceIsReportedByEitherBackend) {

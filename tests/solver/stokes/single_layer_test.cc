@@ -389,7 +389,7 @@ TEST(SingleLayer, CentralSymmetryIsUsedOnlyWhereTheSceneHasIt) {
 }
 
 // The operator's defaults are those of the case registry: a default-constructed operator (tests,
-// benchmarks) is the operator of a default case. (Before issue 12, duffy_order was 6 here and 8 there.)
+// benchmarks) is the operator of a default case.
 TEST(SingleLayer, DefaultsAreTheCaseRegistrys) {
   const SingleLayerOptions o;
   const config::CaseConfig c;

@@ -73,7 +73,7 @@ def main():
     ap.add_argument("--far", action="store_true", help="include the distance-adaptive quadrature variants")
     ap.add_argument("--capsim", default=os.path.join(HERE, "build", "bin", "capsim"))
     ap.add_argument("--out", default=os.path.join(HERE, "results", "pareto"))
-    ap.add_argument("--fig-dir", default=os.path.join(HERE, "results", "figures"))
+    ap.add_argument("--fig-dir", default=os.path.join(HERE, "results", "pareto"))
     ap.add_argument("--runs", default=None, help="where the case folders go (default: OUT/runs, not committed)")
     args = ap.parse_args()
     levels = [int(x) for x in args.levels.split(",")]

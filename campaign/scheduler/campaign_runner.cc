@@ -210,12 +210,12 @@ class Runner {
   // Multi-fidelity: the coarser levels first, since a scan case gates its cell's whole answer level. Within a
   // level the queue goes cell by cell, because refine_campaign releases a cell's next round only when none of
   // its cases runs or waits: a round is of no use to its cell's chain of rounds until its last case ends.
-  // Longest first across cells scattered each round over the whole queue: in the main command (2 workers,
-  // results/main_command_15min/README.md) the three cheap CaH cases of the Skalak a/b 0.5 cell's level-3 round
-  // (25–31 s) waited ≈ 11 min behind the other cells' long cases, and the rounds that needed them (≈ 2–3 min of
-  // dependent cases) then ran alone at the end, one core idle for the last ≈ 215 s. A worker idles only when
-  // nothing is queued and what is left waits for a running case of its own cell, so the rule releases rounds
-  // as early as it can and starts the big ones early:
+  // Longest first across cells scattered each round over the whole queue: in the main command (2 workers;
+  // results/benchmarks.md, "The main command over time") the three cheap CaH cases of the Skalak a/b 0.5
+  // cell's level-3 round (25–31 s) waited ≈ 11 min behind the other cells' long cases, and the rounds that
+  // needed them (≈ 2–3 min of dependent cases) then ran alone at the end, one core idle for the last ≈ 215 s.
+  // A worker idles only when nothing is queued and what is left waits for a running case of its own cell, so
+  // the rule releases rounds as early as it can and starts the big ones early:
   //  1. cells whose round has started (started_cells_) first: finishing it releases the cell's next round, which
   //     then runs beside the other cells' cases; those cost the same later, whereas a started round left
   //     half-run delays its cell's whole chain (the scatter above, in small: a new round added by the top-up
@@ -661,9 +661,10 @@ int run_campaign(const RunOptions& opt, const BeforeRun& before_run) {
   const bool multi_fidelity = !spec.analysis.levels.empty();
   // Cells run ahead of each other, so a cell's scan case must not queue behind another cell's answer-level cases:
   // the coarser levels first. That alone did not shorten the main command's idle tail, the last cell's chain of
-  // dependent rounds (results/main_command_15min/README.md): longest first across cells had spread that cell's
-  // round over the queue, and its next round waits for the round's last case. So within a level the queue also
-  // goes cell by cell, a started round first, then the cells with the most queued work (Runner::order).
+  // dependent rounds (results/benchmarks.md, "The main command over time"): longest first across cells had
+  // spread that cell's round over the queue, and its next round waits for the round's last case. So within a
+  // level the queue also goes cell by cell, a started round first, then the cells with the most queued work
+  // (Runner::order).
   runner.set_coarse_levels_first(multi_fidelity);
   if (multi_fidelity)
     runner.set_top_up([&](const std::vector<CaseParams>& unfinished) {

@@ -84,8 +84,8 @@ struct PeriodOptions {
   /// periods: a steady state is a periodic one whose period has shrunk to nothing, held to the same accuracy,
   /// and the difference of the half-window means is what a drift (a transient still relaxing) changes, while
   /// zero-mean flicker does not. The fluctuation bound keeps real oscillations out: mesh-scale flicker of D12
-  /// is a few 10⁻³ at level 3 (results/steady_spheres), while a swinging or tumbling shape moves D12 by
-  /// O(10⁻²) and more within any 5 time units (results/table1.sqlite). The θ terms convert a rotation into
+  /// is a few 10⁻³ at level 3 (results/validation/steady_spheres), while a swinging or tumbling shape moves D12 by
+  /// O(10⁻²) and more within any 5 time units (results/table1_paper). The θ terms convert a rotation into
   /// the boundary displacement it causes on an ellipse of Taylor parameter D (≈ 2 D δθ, against δD for a
   /// change of D12), so D12 and θ are held to the same shape accuracy; as D12 → 0 (a circular section, whose
   /// θ is noise) they relax by themselves. The window: the shape relaxes on the membrane

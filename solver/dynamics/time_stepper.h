@@ -76,10 +76,11 @@ class TimeIntegrator {
 /// ρ 1.46–1.86 times. Safety 1.0 saves 8–11% of the evaluations on the level-3 cases (a) and (b) and changed
 /// D12 by < 1e-6; it is not the default because the level-3 comparison (where the spheroid calibration
 /// above found ρ Ca h_min up to 6.1 against K = 6.5, a 7% margin) and a stability sweep were not done.
-/// 2026-12-06 (results/rkc_safety_sweep): the main preset's 103 cases (Table 1 grid, levels 2–3, κ_b = 0, Ca
-/// 0.01–3.5, both laws) all ran stably with 1.0, 10.8% / 9.2% fewer evaluations on levels 2 / 3, every
-/// answer within 2.5e-4 of its error; table1_mf_mixed.toml now sets 1.0. The default stays 1.25: changing it
-/// would change the identity of every committed case, and bending and level 4 were not swept.
+/// 2026-12-06 (results/benchmarks.md, "The main command over time"): the main preset's 103 cases (Table 1
+/// grid, levels 2–3, κ_b = 0, Ca 0.01–3.5, both laws) all ran stably with 1.0, 10.8% / 9.2% fewer
+/// evaluations on levels 2 / 3, every answer within 2.5e-4 of its error; table1_mf_mixed.toml now sets 1.0.
+/// The default stays 1.25: changing it would change the identity of every committed case, and bending and
+/// level 4 were not swept.
 inline constexpr double kRkcSafety = 1.25;
 
 /// @brief Heun's method with preallocated stage arrays.

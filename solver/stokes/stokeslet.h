@@ -120,7 +120,7 @@ void sum_blocks(const double x0[3], const Sources& s, const int* begins, int cou
 /// coordinates relative to the target, stokes::KernelPrecision): per target it
 /// stays within kMixedRelativeBound of |u| (tests/solver/stokes/kernel_test.cc), far below the discretisation error;
 /// what it moves in whole cases and campaigns is in results/speed/mixed_ab_case.json and
-/// results/table1_mf_mixed.md. Why it exists: twice the SIMD lanes of sum_fast and a cheaper 1/r (speed-ups in
+/// results/table1/README.md. Why it exists: twice the SIMD lanes of sum_fast and a cheaper 1/r (speed-ups in
 /// results/benchmarks.md, "Mixed precision"): 16 float lanes where the build has AVX-512, 8 with AVX2. Same
 /// contract as sum_fast (u overwritten, a source at zero distance contributes nothing, OpenMP-parallel over
 /// targets, each target's sum independent of the thread count); NaN propagates. The two widths round

@@ -3,7 +3,7 @@
 # successive significant minima of D12 — an approximation of solver/diagnostics/period_analysis, without its
 # steady rules), min D12 and max tau_min, and where a looser time.period_tolerance (2e-3, 5e-3, 1e-2) would have
 # stopped them, with the answer change. Needs the case folders (case.h5) of the database; not part of the product.
-# Usage: /usr/bin/python3 results/time_steps/whole_cases/period_stop.py [DB [CAPSIM]]  (default: results/table1_mf_mixed.sqlite,
+# Usage: /usr/bin/python3 results/time_steps/whole_cases/period_stop.py [DB [CAPSIM]]  (default: results/table1/table1_mf_mixed.sqlite,
 # build/bin/capsim; reads the cases through `capsim query cases`)
 import json
 import subprocess
@@ -12,7 +12,7 @@ import sys
 import h5py
 import numpy as np
 
-db = sys.argv[1] if len(sys.argv) > 1 else "results/table1_mf_mixed.sqlite"
+db = sys.argv[1] if len(sys.argv) > 1 else "results/table1/table1_mf_mixed.sqlite"
 capsim = sys.argv[2] if len(sys.argv) > 2 else "build/bin/capsim"
 cases = json.loads(subprocess.run([capsim, "query", "cases", "--db", db, "--format", "json"], check=True,
                                   capture_output=True, text=True).stdout)

@@ -365,7 +365,7 @@ TEST(Uncertainty, ACoarseLevelWithNoAnswerIsComparedAsInterpolatedValues) {
 }
 
 // The secant that turns an error in max τmin into one in Ca is widened to span 10 % of CaH, but not past the
-// top of a tension window (a sphere: τ < 0 below CaL and above CaH; the NH sphere of results/table1_mf.sqlite
+// top of a tension window (a sphere: τ < 0 below CaL and above CaH; the NH sphere of results/table1_certified
 // on level 3): through the window's far side the secant is nearly flat (0.0024 there) and the error in Ca
 // absurd. Here it widens outwards on the compressed side only.
 TEST(Uncertainty, TheCaHSecantDoesNotWidenAcrossTheTopOfATensionWindow) {

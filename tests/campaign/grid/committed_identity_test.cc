@@ -1,4 +1,5 @@
-// Case identities of the committed databases: every case stored under results/ must get back its own
+// Case identities of the committed databases: every case stored under results/ (and in the store tests' fixture
+// databases) must get back its own
 // case_id when its identity is recomputed from the stored params_json with the solver version recorded in
 // its row. A change to the key registry, the canonical form or the default values that altered an identity
 // would orphan every finished result (the campaign would re-run them as new cases); this test catches it.
@@ -45,15 +46,17 @@ std::vector<StoredCase> stored_cases(const fs::path& db) {
 
 std::vector<fs::path> committed_databases() {
   std::vector<fs::path> dbs;
-  for (const auto& e : fs::recursive_directory_iterator(fs::path(CAPSIM_SOURCE_DIR) / "results"))
-    if (e.is_regular_file() && e.path().extension() == ".sqlite") dbs.push_back(e.path());
+  const fs::path src(CAPSIM_SOURCE_DIR);
+  for (const fs::path& dir : {src / "results", src / "tests" / "campaign" / "store" / "fixtures"})
+    for (const auto& e : fs::recursive_directory_iterator(dir))
+      if (e.is_regular_file() && e.path().extension() == ".sqlite") dbs.push_back(e.path());
   return dbs;
 }
 
 TEST(CommittedIdentity, EveryStoredCaseKeepsItsIdentity) {
   const auto dbs = committed_databases();
   // The Table 1 databases are committed deliverables: their absence is a failure, not a skip.
-  for (const char* required : {"table1.sqlite", "table1_quick.sqlite"}) {
+  for (const char* required : {"table1_mf_mixed.sqlite", "table1_certified.sqlite", "table1_paper.sqlite"}) {
     bool found = false;
     for (const auto& p : dbs) found = found || p.filename() == required;
     EXPECT_TRUE(found) << "results/" << required << " is missing";

@@ -254,7 +254,7 @@ TEST(MultiFidelity, ACellTakesItsNextRoundWhileAnotherCellsCasesRun) {
 // A cell's next round waits for the last case of its round, so the queue keeps a cell's round together and
 // takes the cell with the most queued work first (Runner::order_by_level_and_cell). Longest first across cells
 // had spread a round over the queue: on the main command a cell's cheap cases waited ≈ 11 min behind the other
-// cells' long ones and its later rounds ran alone at the end (results/main_command_15min/README.md). Two cells,
+// cells' long ones and its later rounds ran alone at the end (results/benchmarks.md). Two cells,
 // one worker: the oblate cell has the most scan work, the prolate one the single longest scan case (Ca 0.005).
 TEST(MultiFidelity, ACellsRoundRunsAsOneBlockTheCellWithTheMostQueuedWorkFirst) {
   const std::string dir = fresh_dir("multi_fidelity_cell_blocks");

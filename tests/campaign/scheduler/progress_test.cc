@@ -135,13 +135,14 @@ TEST(EtaModel, AResumedCaseCountsOnlyThePartAfterItsCheckpoint) {
 // of the estimator that is not recalibrated moves β away (the estimate ∝ 1/Ca it replaced gives 0.19–0.33).
 // A fit presumes one kind of machine: a level whose results name more than one instruction set (kernel_isa;
 // results from before it was recorded name none) is not fitted — the same case costs 3.5× more on the AVX2
-// machine than on the AVX-512 one (results/main_command_avx512), so no single power law holds across them (the
+// machine than on the AVX-512 one (results/benchmarks.md), so no single power law holds across them (the
 // certified table's level 4, 42 cases run on both: β = 0.44 pooled; 0.75 / 0.65 / 0.39 for its 11 double,
 // 11 AVX2-mixed and 16 AVX-512-mixed cases, each too few to fit alone).
 TEST(EtaModel, TheCostExponentIsTheFitOfTheCommittedDatabases) {
   int fits = 0;
-  for (const char* name : {"results/table1.sqlite", "results/table1_certified.sqlite", "results/table1_mf_mixed.sqlite",
-                           "results/bending/table1_bending.sqlite"}) {
+  for (const char* name :
+       {"results/table1_paper/table1_paper.sqlite", "results/table1_certified/table1_certified.sqlite",
+        "results/table1/table1_mf_mixed.sqlite", "results/bending/table1_bending.sqlite"}) {
     auto store = Store::open_readonly(std::string(CAPSIM_SOURCE_DIR) + "/" + name);
     Stmt s(store->db(),
            "SELECT c.params_json, r.wall_s, coalesce(json_extract(r.raw_json, '$.kernel_isa'), '') "

@@ -11,7 +11,9 @@ namespace capsim::campaign::testing {
 namespace {
 
 TEST(Migration, Version2DatabaseMigratesToGroupKeysAndKeepsTable1) {
-  const fs::path committed = fs::path(CAPSIM_SOURCE_DIR) / "results" / "table1_quick.sqlite";
+  // The quick preset's campaign as it was first run (level 2, schema version 2), kept as the fixture.
+  const fs::path committed =
+      fs::path(CAPSIM_SOURCE_DIR) / "tests" / "campaign" / "store" / "fixtures" / "schema_v2_quick.sqlite";
   ASSERT_TRUE(fs::exists(committed)) << committed;
   const std::string dir = fresh_dir("migration_v2");
   const std::string db = dir + "/quick.sqlite";

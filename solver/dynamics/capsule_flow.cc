@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <numbers>
+#include <utility>
 
 #include "solver/dynamics/time_stepper.h"
 
@@ -43,57 +44,105 @@ CapsuleFlow::CapsuleFlow(const config::CaseConfig& c) : Ca_(c.capillary_number) 
 
 CapsuleFlow::~CapsuleFlow() = default;
 
+void CapsuleFlow::begin_step() {
+  load_guess_ = false;
+  if (second_kind_) second_kind_->begin_step();
+}
+
+void CapsuleFlow::set_second_kind_solve(std::unique_ptr<SecondKindSolve> solve) { second_kind_ = std::move(solve); }
+
+membrane::MembraneState CapsuleFlow::elastic_force(const Eigen::Matrix3Xd& x, bool& central) {
+  const auto t0 = std::chrono::steady_clock::now();
+  // With numerics.central_symmetry and a centrally symmetric x (to the boundary integral's position tolerance),
+  // half the elements, the others their images (MembraneMechanics::evaluate_centrally_symmetric); the load can
+  // then be solved for one node of each pair {i, −i} (LoadMatrix::AssembleCentral).
+  const stokes::SingleLayerOptions& so = single_layer_->options();
+  central = so.central_symmetry && mesh::is_centrally_symmetric(*mesh_, x, so.symmetry_tol);
+  membrane::MembraneState s = central ? mechanics_->evaluate_centrally_symmetric(x, /*with_energy=*/false)
+                                      : mechanics_->evaluate(x, /*with_energy=*/false);
+  timings_.membrane_s += seconds_since(t0);
+  return s;
+}
+
+void CapsuleFlow::bending_force(const Eigen::Matrix3Xd& x) {
+  const auto t0 = std::chrono::steady_clock::now();
+  bending_state_ = bending_->evaluate(x, *load_solver_);
+  timings_.bending_s += seconds_since(t0);
+}
+
+void CapsuleFlow::solve_load(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, bool warm,
+                             LoadMatrix matrix) {
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    switch (matrix) {
+      case LoadMatrix::Factorised: load_solver_->solve(R, q, warm); break;
+      case LoadMatrix::AssembleCentral: load_solver_->compute_load_centrally_symmetric(x, R, q, warm); break;
+      case LoadMatrix::Assemble: load_solver_->compute_load(x, R, q, warm); break;
+    }
+  } catch (const std::runtime_error& e) {
+    throw membrane::DegenerateSurface(e.what());
+  }
+  timings_.load_s += seconds_since(t0);
+}
+
 membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q) {
   return membrane_load(x, q, false);
 }
 
 membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q, bool warm) {
-  auto t0 = std::chrono::steady_clock::now();
-  // With numerics.central_symmetry and a centrally symmetric x (to the boundary integral's position tolerance),
-  // half the elements, the others their images (MembraneMechanics::evaluate_centrally_symmetric), and the load
-  // solved for one node of each pair {i, −i} (LoadSolver::compute_load_centrally_symmetric; not with bending,
-  // whose evaluation factorises the full mass matrix itself).
-  const stokes::SingleLayerOptions& so = single_layer_->options();
-  const bool central = so.central_symmetry && mesh::is_centrally_symmetric(*mesh_, x, so.symmetry_tol);
-  membrane::MembraneState s = central ? mechanics_->evaluate_centrally_symmetric(x, /*with_energy=*/false)
-                                      : mechanics_->evaluate(x, /*with_energy=*/false);
-  timings_.membrane_s += seconds_since(t0);
-  t0 = std::chrono::steady_clock::now();
-  // With bending: its evaluation factorises the mass matrix on x (its two mass solves need it), and the
-  // load solve reuses that factorisation for M q = R_elastic + R_b.
-  if (bending_) {
-    bending_state_ = bending_->evaluate(x, *load_solver_);
-    timings_.bending_s += seconds_since(t0);
-    t0 = std::chrono::steady_clock::now();
+  bool central = false;
+  const membrane::MembraneState s = elastic_force(x, central);
+  if (!bending_) {
+    solve_load(x, s.internal_force, q, warm, central ? LoadMatrix::AssembleCentral : LoadMatrix::Assemble);
+    return s;
   }
-  try {
-    if (bending_)
-      load_solver_->solve(s.internal_force + bending_state_.internal_force, q, warm);
-    else if (central)
-      load_solver_->compute_load_centrally_symmetric(x, s.internal_force, q, warm);
-    else
-      load_solver_->compute_load(x, s.internal_force, q, warm);
-  } catch (const std::runtime_error& e) {
-    throw membrane::DegenerateSurface(e.what());
-  }
-  timings_.load_s += seconds_since(t0);
+  // With bending: its evaluation factorises the mass matrix on x (its two mass solves need it), and the load
+  // solve reuses that factorisation for M q = R_elastic + R_b (on the full mesh: the bending evaluation has no
+  // reduced form).
+  bending_force(x);
+  solve_load(x, s.internal_force + bending_state_.internal_force, q, warm, LoadMatrix::Factorised);
   return s;
 }
 
+membrane::MembraneState CapsuleFlow::elastic_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q) {
+  bool central = false;
+  const membrane::MembraneState s = elastic_force(x, central);
+  solve_load(x, s.internal_force, q, false, central ? LoadMatrix::AssembleCentral : LoadMatrix::Assemble);
+  return s;
+}
+
+const membrane::BendingState& CapsuleFlow::bending_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q) {
+  if (!bending_) {
+    bending_state_ = membrane::BendingState{};
+    q.setZero(3, x.cols());
+    return bending_state_;
+  }
+  bending_force(x);
+  solve_load(x, bending_state_.internal_force, q, false, LoadMatrix::Factorised);
+  return bending_state_;
+}
+
 FlowEvaluation CapsuleFlow::velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, Eigen::Matrix3Xd* load) {
-  FlowEvaluation out;
   // q_ holds the previous evaluation's load (a valid one only while load_guess_): the warm start's guess.
   const bool warm = load_warm_start_ && load_guess_;
   load_guess_ = false;  // until this solve has succeeded
   const membrane::MembraneState s = membrane_load(x, q_, warm);
   load_guess_ = true;
+  FlowEvaluation out = boundary_velocity(x, q_, v);
   out.tau_min = s.tau_min;
   out.tau_max = s.tau_max;
   out.bending_energy = bending_state_.energy;
   out.max_bending_moment = bending_state_.max_moment;
+  if (load) *load = q_;
+  ++timings_.evaluations;
+  return out;
+}
 
+FlowEvaluation CapsuleFlow::boundary_velocity(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q,
+                                              Eigen::Matrix3Xd& v) {
+  FlowEvaluation out;
   auto t0 = std::chrono::steady_clock::now();
-  single_layer_->apply(x, q_, u_);
+  single_layer_->apply(x, q, u_);
   timings_.stokes_s += seconds_since(t0);
   const stokes::SingleLayerStats& st = single_layer_->last_stats();
   out.used_symmetry = st.used_symmetry;
@@ -107,9 +156,21 @@ FlowEvaluation CapsuleFlow::velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd
 
   // v = v∞ − u/(8π Ca): the membrane pushes the fluid with −q (solver/README.md §3).
   const double factor = -1.0 / (8.0 * std::numbers::pi * Ca_);
-  v = factor * u_;
-  out.max_speed = v.colwise().norm().maxCoeff();
-  if (background_flow_) v.row(0) += x.row(1);
+  // With a viscosity contrast this is f, the right-hand side of the second-kind solve, and v its solution.
+  Eigen::Matrix3Xd& f = second_kind_ ? f_ : v;
+  f = factor * u_;
+  out.max_speed = f.colwise().norm().maxCoeff();
+  if (background_flow_) f.row(0) += x.row(1);
+  if (second_kind_) {
+    timings_.volume_s += seconds_since(t0);
+    t0 = std::chrono::steady_clock::now();
+    second_kind_->solve(x, f_, v);
+    timings_.second_kind_s += seconds_since(t0);
+    t0 = std::chrono::steady_clock::now();
+    u_ = v;  // max |v − v∞| of the solution
+    if (background_flow_) u_.row(0) -= x.row(1);
+    out.max_speed = u_.colwise().norm().maxCoeff();
+  }
   // Discrete flux of v and of the node normals through the P2 surface; remove the spurious part.
   normals_ = mesh::node_normals(*mesh_, x);
   // Per element in parallel, then summed in element order (deterministic for any thread count).
@@ -138,8 +199,6 @@ FlowEvaluation CapsuleFlow::velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd
   out.volume_flux = flux_v;
   if (volume_correction_) v -= (flux_v / flux_n) * normals_;
   timings_.volume_s += seconds_since(t0);
-  if (load) *load = q_;
-  ++timings_.evaluations;
   return out;
 }
 

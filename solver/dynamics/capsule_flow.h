@@ -29,11 +29,12 @@
 
 namespace capsim::dynamics {
 
-/// @brief Side results of one flow evaluation.
+/// @brief Side results of one flow evaluation. boundary_velocity fills the boundary fields (max_speed,
+/// used_symmetry, used_central, volume_flux) alone; velocity fills all.
 struct FlowEvaluation {
   double tau_min = 0.0;         ///< smallest principal tension on x
   double tau_max = 0.0;         ///< largest principal tension on x
-  double max_speed = 0.0;       ///< max |v − v∞| over the nodes
+  double max_speed = 0.0;       ///< max |v − v∞| over the nodes (before the volume correction)
   bool used_symmetry = false;   ///< whether the boundary integral used the mirror symmetry
   bool used_central = false;    ///< whether it used the point symmetry x → −x (numerics.central_symmetry)
   double volume_flux = 0.0;     ///< ∫ v·n dS of the uncorrected discrete velocity (0 for the exact flow)
@@ -41,8 +42,9 @@ struct FlowEvaluation {
   double max_bending_moment = 0.0;  ///< max κ_b |c − c0| on x (solver/membrane/bending.h)
 };
 
-/// @brief Accumulated wall time of the phases of flow evaluations (exafmm-style named phases).
-/// The boundary integral's total (stokes_s) is split into the SingleLayer phases (SingleLayerStats).
+/// @brief Accumulated wall time of the phases of flow evaluations (exafmm-style named phases), whichever
+/// public phase of CapsuleFlow ran them. The boundary integral's total (stokes_s) is split into the
+/// SingleLayer phases (SingleLayerStats).
 struct FlowTimings {
   double membrane_s = 0.0;   ///< kinematics, elastic energy gradient
   double bending_s = 0.0;    ///< bending energy gradient with its two mass solves (0 when κ_b = 0)
@@ -53,30 +55,93 @@ struct FlowTimings {
   double far_s = 0.0;        ///< far-field tier (0 when off)
   double singular_s = 0.0;   ///< Duffy correction of the elements containing each node
   double near_s = 0.0;       ///< near-singular correction of their neighbours, mirror
+  double second_kind_s = 0.0;  ///< the SecondKindSolve of a viscosity contrast (0 without one)
   double volume_s = 0.0;     ///< v = v∞ − u/(8πCa), node normals, flux and volume correction
-  long evaluations = 0;
+  long evaluations = 0;      ///< calls of CapsuleFlow::velocity (the phases called alone do not count)
+};
+
+/// @brief The second-kind boundary integral equation of a viscosity contrast λ ≠ 1 (inner/outer viscosity),
+/// the place where the interior fluid enters CapsuleFlow::boundary_velocity. With f = v∞ − S[q]/(8π Ca) the
+/// surface velocity of equal viscosities (the single layer of the load), the velocity v of the contrast solves
+///   (1 + λ)/2 · v(x0) − (1 − λ)/(8π) · PV∫_S v(x)·T(x − x0)·n(x) dS(x) = f(x0)
+/// (../shared/DESIGN.md §10; the double layer D lives beside the single layer in solver/stokes). At λ = 1 the
+/// equation is v = f and CapsuleFlow has no SecondKindSolve: the λ = 1 path is bitwise the one without the seam.
+///
+/// Contract for an implementation:
+/// - `solve(x, f, v)`: x and f are 3 × N (nodes of the CapsuleFlow's mesh), v is output only (3 × N on
+///   return). The solve is linear in f at fixed x; f already holds v∞ (zero with the background flow off).
+///   CapsuleFlow applies the volume correction to the returned v (its flux, not f's, is reported).
+/// - It may carry state between calls (a warm start from the previous stage's v), but `begin_step` must forget
+///   it, as CapsuleFlow::begin_step does for the load: a resumed run then repeats an uninterrupted one bitwise.
+/// - A solve that does not converge throws an exception derived from std::runtime_error whose what() names the
+///   cause; the caller records it as the case's outcome (a numerical result, never a wrong velocity).
+/// - The mirror and point symmetries hold for the double layer as for the single layer: an implementation that
+///   uses them must check them on (x, f) itself, as SingleLayer does on (x, q).
+class SecondKindSolve {
+ public:
+  virtual ~SecondKindSolve() = default;
+  /// @brief v with (1+λ)/2 v − (1−λ)/(8π) D_x[v] = f on the nodes of x.
+  virtual void solve(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& f, Eigen::Matrix3Xd& v) = 0;
+  /// @brief A time step begins (CapsuleFlow::begin_step): drop every warm start.
+  virtual void begin_step() {}
 };
 
 /// @brief Mesh, law, membrane, load solver and boundary-integral operator of one case, built once.
 ///
-/// Contract: the mesh connectivity and reference shape are fixed at construction; `velocity` may be called
-/// on any positions of the same mesh. Not thread-safe (caches factorisations and work arrays); internally
-/// OpenMP-parallel.
+/// A flow evaluation is a composition of public phases, so that a time integrator can treat them differently
+/// (an implicit bending step, the second-kind solve of a viscosity contrast) without reaching inside:
+///
+///   velocity(x)          = boundary_velocity(x, membrane_load(x))
+///   membrane_load(x)     = M(x)⁻¹ (R_el(x) + R_b(x))     one load solve of the summed forces
+///   elastic_load(x)      = M(x)⁻¹ R_el(x)                 the elastic law's part alone
+///   bending_load(x)      = M(x)⁻¹ R_b(x)                  the bending part alone (0 when κ_b = 0)
+///   boundary_velocity(x, q) = P_x [ K( v∞ − S_x[q]/(8π Ca) ) ]
+///
+/// S_x the single layer (stokes::SingleLayer), K the SecondKindSolve (the identity without one, λ = 1), P_x the
+/// volume correction (numerics.volume_correction; the identity when off). membrane_load = elastic_load +
+/// bending_load to the load solve's tolerance (numerics.load_tolerance, relative), not bitwise: velocity solves
+/// once for the summed forces, the path every committed result was computed on. At fixed x, boundary_velocity is
+/// affine in q, and linear with the background flow off (set_background_flow(false)): the form a linearly
+/// implicit step needs, e.g. v = boundary_velocity(x, q_el) + (bending velocity, background off) with the second
+/// term treated implicitly. Each phase adds its wall time to its FlowTimings field whoever calls it.
+///
+/// Contract: the mesh connectivity and reference shape are fixed at construction; every phase may be called on
+/// any positions of the same mesh (3 × N). Not thread-safe (caches factorisations and work arrays); internally
+/// OpenMP-parallel, and bitwise the same on any number of threads.
 class CapsuleFlow {
  public:
   explicit CapsuleFlow(const config::CaseConfig& config);
   ~CapsuleFlow();
 
-  /// @brief v on positions x (3 × N). Also fills q (the membrane load) when asked.
+  /// @brief One flow evaluation: v on positions x (3 × N), boundary_velocity(x, membrane_load(x)); also fills q
+  /// (the membrane load) when asked. With numerics.load_warm_start, the load solve starts from the previous
+  /// evaluation's load within a step (begin_step).
   /// @throws membrane::DegenerateSurface if x has a collapsed element (a blow-up).
   FlowEvaluation velocity(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, Eigen::Matrix3Xd* load = nullptr);
-  /// @brief The membrane load q on positions x alone (membrane + load solve, no boundary integral): for diagnostics
-  /// that need q but not v. Not counted as a flow evaluation; its time goes to the membrane and load phases. Returns
-  /// the membrane state (tensions, elastic forces; not the energy, NaN); with bending stiffness q includes the bending
-  /// load, whose energy and largest moment last_bending() holds.
+
+  /// @brief The membrane load q on positions x (elastic and bending forces, one load solve from zero; no boundary
+  /// integral): for diagnostics that need q but not v, and for integrators that compose the phases themselves.
+  /// Not counted as a flow evaluation. Returns the membrane state (tensions, elastic forces; not the energy, NaN);
+  /// with bending stiffness q includes the bending load, whose energy and largest moment last_bending() holds.
   /// @throws membrane::DegenerateSurface if x has a collapsed element.
   membrane::MembraneState membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q);
-  /// @brief Bending energy and largest moment of the last membrane_load / velocity (zero without bending).
+  /// @brief The elastic law's load alone, q = M(x)⁻¹ R_el(x) (from zero), as membrane_load without bending.
+  /// @throws membrane::DegenerateSurface if x has a collapsed element.
+  membrane::MembraneState elastic_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q);
+  /// @brief The bending load alone, q = M(x)⁻¹ R_b(x) (from zero); q = 0 (3 × N) when κ_b = 0. Returns the bending
+  /// state (energy, largest moment, R_b), also kept as last_bending().
+  /// @throws membrane::DegenerateSurface if x has a collapsed element.
+  const membrane::BendingState& bending_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q);
+  /// @brief The fluids' part: v = P_x[K(v∞ − S_x[q]/(8π Ca))] for a load q (3 × N) on positions x (see the class
+  /// comment). Fills the boundary fields of the returned FlowEvaluation. Not counted as a flow evaluation.
+  /// @throws whatever the SecondKindSolve throws when it does not converge (never without one).
+  FlowEvaluation boundary_velocity(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Eigen::Matrix3Xd& v);
+
+  /// @brief Install the second-kind solve of a viscosity contrast (nullptr: none, λ = 1, the default).
+  void set_second_kind_solve(std::unique_ptr<SecondKindSolve> solve);
+
+  /// @brief Bending energy and largest moment of the last membrane_load / bending_load / velocity (zero without
+  /// bending).
   [[nodiscard]] const membrane::BendingState& last_bending() const { return bending_state_; }
   /// @brief κ_b (capsule.bending_modulus).
   [[nodiscard]] double bending_modulus() const { return bending_ ? bending_->model().modulus() : 0.0; }
@@ -91,13 +156,27 @@ class CapsuleFlow {
   /// @brief Switch the undisturbed shear flow v∞ off (fluid at rest: relaxation tests) or on (default).
   void set_background_flow(bool on) { background_flow_ = on; }
   /// @brief A time step begins: with numerics.load_warm_start, the next `velocity` starts its load solve from
-  /// zero again (later ones from the previous evaluation's load). The driver calls it before every step, so
-  /// that nothing carried between steps is missing from a checkpoint and a resumed run repeats an
-  /// uninterrupted one bitwise. Without the warm start it changes nothing.
-  void begin_step() { load_guess_ = false; }
+  /// zero again (later ones from the previous evaluation's load), and the SecondKindSolve drops its warm start.
+  /// The driver calls it before every step, so that nothing carried between steps is missing from a checkpoint
+  /// and a resumed run repeats an uninterrupted one bitwise. Without either it changes nothing.
+  void begin_step();
 
  private:
-  // membrane_load, with the load solve started from q's values when `warm` (LoadSolver::solve).
+  // How the load solve gets its mass matrix on x.
+  enum class LoadMatrix {
+    Assemble,         // assemble and factorise M(x): compute_load
+    AssembleCentral,  // the same, reduced to one node of each pair {i, −i}: compute_load_centrally_symmetric
+    Factorised,       // M(x) already factorised by the bending evaluation on x: solve
+  };
+  // The elastic forces on x; `central`: whether x is centrally symmetric and the case uses it (then the forces
+  // are those of half the elements and their images). Timed as membrane_s.
+  membrane::MembraneState elastic_force(const Eigen::Matrix3Xd& x, bool& central);
+  // The bending forces on x into bending_state_, leaving the load solver factorised on x. Timed as bending_s.
+  void bending_force(const Eigen::Matrix3Xd& x);
+  // M(x) q = R, from q's values when `warm` (LoadSolver::solve). Timed as load_s.
+  void solve_load(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, bool warm,
+                  LoadMatrix matrix);
+  // membrane_load, with the load solve started from q's values when `warm`.
   membrane::MembraneState membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q, bool warm);
 
   double Ca_;
@@ -108,7 +187,8 @@ class CapsuleFlow {
   std::unique_ptr<membrane::BendingMechanics> bending_;  // null when κ_b = 0: the seed's membrane, untouched
   membrane::BendingState bending_state_;
   std::unique_ptr<stokes::SingleLayer> single_layer_;
-  Eigen::Matrix3Xd q_, u_;
+  std::unique_ptr<SecondKindSolve> second_kind_;  // null: λ = 1, v = f
+  Eigen::Matrix3Xd q_, u_, f_;
   bool load_warm_start_ = false;  // numerics.load_warm_start
   bool load_guess_ = false;       // q_ is the load of a successful evaluation since the last begin_step()
   FlowTimings timings_;

@@ -138,18 +138,11 @@ double membrane_spectral_radius(const mesh::SurfaceMesh& mesh, const Eigen::Matr
 }
 
 double estimate_spectral_radius(CapsuleFlow& flow, const Eigen::Matrix3Xd& x, int iterations) {
-  const auto& mirror = flow.mesh().mirror_node;
+  // On a mirror-symmetric x the iterate is projected onto the symmetric fields (mesh::symmetrise, the driver's
+  // projection of a state), so that the estimate is over the modes a symmetric run can excite.
   const bool symmetric = mesh::is_mirror_symmetric(flow.mesh(), x, 1e-12);
   auto symmetrise = [&](Eigen::Matrix3Xd& z) {
-    if (!symmetric) return;
-    Eigen::Matrix3Xd zs = z;
-    for (int i = 0; i < z.cols(); ++i) {
-      const int m = mirror[i];
-      zs(0, i) = 0.5 * (z(0, i) + z(0, m));
-      zs(1, i) = 0.5 * (z(1, i) + z(1, m));
-      zs(2, i) = 0.5 * (z(2, i) - z(2, m));
-    }
-    z = zs;
+    if (symmetric) mesh::symmetrise(flow.mesh(), z);
   };
   Eigen::Matrix3Xd v0, v1, z(3, x.cols());
   flow.velocity(x, v0);

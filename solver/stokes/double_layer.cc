@@ -1,5 +1,6 @@
 #include "solver/stokes/double_layer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -25,19 +26,49 @@ DoubleLayer::DoubleLayer(const mesh::SurfaceMesh& mesh, const SingleLayerOptions
   for (int l = 0; l < 6; ++l) duffy_[l] = make_point_table(duffy_rule(l, opt_.duffy_order));
   if (opt_.near_subdivision > 0) {
     near_rule_ = replace_rule(subdivided_rule(opt_.near_subdivision, opt_.near_degree), regular_);
+    // Padded with zero-weight points (zero normal, at the centroid) to whole lanes: add_double_layer_blocks.
+    while (near_rule_.size() % kDoubleLayerLanes != 0) near_rule_.push_back(mesh::p2_point(1.0 / 3, 1.0 / 3, 0.0));
     near_ = near_singular_elements(mesh);
+    near_begin_.resize(near_.elements.size());
+    for (std::size_t k = 0; k < near_.elements.size(); ++k)
+      near_begin_[k] = near_.elements[k] * static_cast<int>(near_rule_.size());
   }
 }
 
 void DoubleLayer::regular_sum(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v, Eigen::Matrix3Xd& u) const {
+  // Targets in lanes, kTile per tile (two AVX-512 vectors of doubles: register blocking), one source broadcast
+  // at a time, as the portable tile of the Stokeslet sum (kernel::add_sources_to_lanes). The last tile is padded
+  // with copies of its last target (their results are dropped).
+  constexpr int kTile = 16;
   const int n = static_cast<int>(sources_.x.size()), nt = static_cast<int>(targets_.size());
+  const int tiles = (nt + kTile - 1) / kTile;
+  const double *sx = sources_.x.data(), *sy = sources_.y.data(), *sz = sources_.z.data();
+  const double *svx = sources_.vx.data(), *svy = sources_.vy.data(), *svz = sources_.vz.data();
+  const double *snx = sources_.nx.data(), *sny = sources_.ny.data(), *snz = sources_.nz.data();
 #pragma omp parallel for schedule(static)
-  for (int it = 0; it < nt; ++it) {
-    const int i = targets_[it];
-    const double x0[3] = {x(0, i), x(1, i), x(2, i)}, v0[3] = {v(0, i), v(1, i), v(2, i)};
-    double acc[3] = {0.0, 0.0, 0.0};
-    add_double_layer_block(x0, v0, sources_, 0, n, 1.0, acc);
-    for (int c = 0; c < 3; ++c) u(c, i) = acc[c];
+  for (int b = 0; b < tiles; ++b) {
+    alignas(64) double tx[kTile], ty[kTile], tz[kTile], tvx[kTile], tvy[kTile], tvz[kTile];
+    alignas(64) double ax[kTile] = {}, ay[kTile] = {}, az[kTile] = {};
+    for (int l = 0; l < kTile; ++l) {
+      const int i = targets_[std::min(b * kTile + l, nt - 1)];
+      tx[l] = x(0, i), ty[l] = x(1, i), tz[l] = x(2, i);
+      tvx[l] = v(0, i), tvy[l] = v(1, i), tvz[l] = v(2, i);
+    }
+    for (int j = 0; j < n; ++j) {
+      const double px = sx[j], py = sy[j], pz = sz[j], qx = svx[j], qy = svy[j], qz = svz[j], mx = snx[j],
+                   my = sny[j], mz = snz[j];
+#pragma omp simd aligned(tx, ty, tz, tvx, tvy, tvz, ax, ay, az : 64)
+      for (int l = 0; l < kTile; ++l) {
+        const double rx = px - tx[l], ry = py - ty[l], rz = pz - tz[l];
+        const double r2 = rx * rx + ry * ry + rz * rz;
+        const double inv = r2 == 0.0 ? 0.0 : kernel::rsqrt_arith(r2);
+        kernel::add_stresslet(rx, ry, rz, qx - tvx[l], qy - tvy[l], qz - tvz[l], mx, my, mz, inv, ax[l], ay[l], az[l]);
+      }
+    }
+    for (int l = 0; l < kTile && b * kTile + l < nt; ++l) {
+      const int i = targets_[b * kTile + l];
+      u(0, i) = ax[l], u(1, i) = ay[l], u(2, i) = az[l];
+    }
   }
 }
 
@@ -67,11 +98,19 @@ void DoubleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Ma
       const PointTable& tb = duffy_[topo_.inc_local[k]];
       const double *pxi = tb.xi.data(), *peta = tb.eta.data(), *wt = tb.w.data();
       double sx = 0.0, sy = 0.0, sz = 0.0;
+      // The geometry of mesh::p2_monomial_geometry written out: through that helper's array arguments GCC 12
+      // keeps the arrays in memory in `omp simd` loops (p2_element.h), which made this phase 3× slower.
 #pragma omp simd reduction(+ : sx, sy, sz)
       for (int p = 0; p < tb.count; ++p) {
+        const double xi = pxi[p], eta = peta[p];
         double d[3], g1[3], g2[3], dv[3];
-        mesh::p2_monomial_geometry(C, pxi[p], peta[p], d, g1, g2);
-        mesh::p2_monomial_value(D, pxi[p], peta[p], dv);
+        for (int c = 0; c < 3; ++c) {
+          const double e = C[1][c] + xi * C[3][c] + eta * C[4][c], h = C[2][c] + eta * C[5][c];
+          d[c] = C[0][c] + xi * e + eta * h;
+          g1[c] = e + xi * C[3][c];
+          g2[c] = h + xi * C[4][c] + eta * C[5][c];
+          dv[c] = D[0][c] + xi * (D[1][c] + xi * D[3][c] + eta * D[4][c]) + eta * (D[2][c] + eta * D[5][c]);
+        }
         const double w = wt[p];
         const double nx = w * (g1[1] * g2[2] - g1[2] * g2[1]), ny = w * (g1[2] * g2[0] - g1[0] * g2[2]),
                      nz = w * (g1[0] * g2[1] - g1[1] * g2[0]);
@@ -97,10 +136,8 @@ void DoubleLayer::near_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix
     const double x0[3] = {x(0, i), x(1, i), x(2, i)}, v0[3] = {v(0, i), v(1, i), v(2, i)};
     double acc[3] = {0.0, 0.0, 0.0};
     // Near-singular neighbours: subdivided rule in, regular rule out (negative weights), one block each.
-    for (int k = near_.offsets[i]; k < near_.offsets[i + 1]; ++k) {
-      const int b = near_.elements[k] * nr;
-      add_double_layer_block(x0, v0, near_points_, b, b + nr, 1.0, acc);
-    }
+    add_double_layer_blocks(x0, v0, near_points_, near_begin_.data() + near_.offsets[i],
+                            near_.offsets[i + 1] - near_.offsets[i], nr, acc);
     for (int c = 0; c < 3; ++c) u(c, i) += acc[c];
   }
 }

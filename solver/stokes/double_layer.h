@@ -110,6 +110,7 @@ class DoubleLayer {
   PointTable duffy_[6];                   // Duffy rule per local node position (SoA)
   std::vector<mesh::P2Point> near_rule_;  // subdivided rule, then the regular rule negated (empty if off)
   NearSingularElements near_;             // node → near-singular elements (empty if off)
+  std::vector<int> near_begin_;           // first near point of each entry of near_.elements
   // Work arrays of apply().
   std::vector<int> targets_;              // the nodes evaluated (all, or one of each orbit)
   NormalSourceArrays sources_;            // regular points of every element

@@ -274,7 +274,9 @@ TEST(SecondKindSolve, DeflationBoundsTheIterationsAcrossViscosityRatios) {
       const auto it = iterations(op, m, m.nodes, f, lambda);
       lo = std::min(lo, it[0]);
       hi = std::max(hi, it[0]);
-      if (lambda <= 1e-3 || lambda >= 1e3) EXPECT_GE(it[1], it[0] + 2) << "λ " << lambda;
+      if (lambda <= 1e-3 || lambda >= 1e3) {
+        EXPECT_GE(it[1], it[0] + 2) << "λ " << lambda;
+      }
     }
     EXPECT_LE(hi - lo, 2);
   }

@@ -35,7 +35,8 @@
 /// near_degree) and the symmetry fields (symmetry, central_symmetry, symmetry_tol, load_symmetry_tol), so that
 /// the two layers of one case integrate on the same rules with the same symmetries. The far-field tier, the kernel
 /// choice and the mixed precision of the single layer are not implemented here and are ignored: every phase
-/// runs in double with the `omp simd` loops of add_double_layer_block.
+/// runs in double, in `omp simd` loops (the regular sum with targets in lanes, 16 per tile; the near-singular
+/// blocks with add_double_layer_blocks; the Duffy points with add_stresslet).
 ///
 /// Contract: as SingleLayer (connectivity cached from the constructor and unchanging; positions and density may
 /// change freely between calls; one object must not be used by two threads at once; internally OpenMP-parallel

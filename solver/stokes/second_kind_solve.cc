@@ -101,17 +101,20 @@ void gmres(SystemOperator& op, const Vec& g, Vec& w, bool warm, const SecondKind
   } else {
     w.setZero();
   }
-  double beta = r.norm();
-  out.residual = beta / gnorm;
-  if (!std::isfinite(out.residual)) {
-    out.reason = "non-finite residual";
-    return;
-  }
-  if (out.residual <= opt.tolerance) {
+  // Whether the solve ends at the residual norm b: not finite, or converged (then with `why`).
+  auto settled = [&](double b, const char* why) {
+    out.residual = b / gnorm;
+    if (!std::isfinite(out.residual)) {
+      out.reason = "non-finite residual";
+      return true;
+    }
+    if (out.residual > opt.tolerance) return false;
     out.converged = true;
-    out.reason = "initial guess already converged";
-    return;
-  }
+    out.reason = why;
+    return true;
+  };
+  double beta = r.norm();
+  if (settled(beta, "initial guess already converged")) return;
   const int m = opt.restart;
   const Eigen::Index size = g.size();
   Eigen::MatrixXd basis(size, m + 1), hess(m + 1, m), rot(m + 1, m);
@@ -127,6 +130,7 @@ void gmres(SystemOperator& op, const Vec& g, Vec& w, bool warm, const SecondKind
       Vec z = op.apply(basis.col(j));
       ++out.iterations;
       ++out.applications;
+      const double znorm = z.norm();  // |Â v_j|, the scale of the breakdown test below
       for (int i = 0; i <= j; ++i) {
         hess(i, j) = basis.col(i).dot(z);
         z -= hess(i, j) * basis.col(i);
@@ -144,8 +148,8 @@ void gmres(SystemOperator& op, const Vec& g, Vec& w, bool warm, const SecondKind
       s(j + 1) = -sn(j) * s(j);
       s(j) = cs(j) * s(j);
       ++j;
-      // A (near) invariant Krylov space: the solution lies in it.
-      breakdown = !(hess(j, j - 1) > 1e-14 * gnorm);
+      // A (near) invariant Krylov space: the solution lies in it (|v_j| = 1, so the test is relative to |Â v_j|).
+      breakdown = !(hess(j, j - 1) > 1e-14 * znorm);
       if (breakdown) {
         basis.col(j).setZero();
         break;
@@ -157,16 +161,7 @@ void gmres(SystemOperator& op, const Vec& g, Vec& w, bool warm, const SecondKind
     w += basis.leftCols(j) * y;
     r = beta * basis.col(0) - basis.leftCols(j + 1) * (hess.topLeftCorner(j + 1, j) * y);
     beta = r.norm();
-    out.residual = beta / gnorm;
-    if (!std::isfinite(out.residual)) {
-      out.reason = "non-finite residual";
-      return;
-    }
-    if (out.residual <= opt.tolerance) {
-      out.converged = true;
-      out.reason = "converged";
-      return;
-    }
+    if (settled(beta, "converged")) return;
     if (breakdown) {
       out.reason = "breakdown";
       return;

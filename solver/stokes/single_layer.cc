@@ -112,7 +112,7 @@ bool SingleLayerOptions::valid(std::string* why) const {
 
 SingleLayer::SingleLayer(const mesh::SurfaceMesh& mesh, const SingleLayerOptions& options) : opt_(options) {
   if (std::string why; !opt_.valid(&why)) throw std::invalid_argument("stokes: " + why);
-  copy_connectivity(mesh);
+  topo_ = make_boundary_mesh(mesh);
   const auto regular = mesh::P2Tabulation::of_degree(opt_.regular_degree);
   regular_.assign(regular.points().begin(), regular.points().end());
   rule_size_ = static_cast<int>(regular_.size());
@@ -136,80 +136,23 @@ SingleLayer::SingleLayer(const mesh::SurfaceMesh& mesh, const SingleLayerOptions
   }
 }
 
-void SingleLayer::copy_connectivity(const mesh::SurfaceMesh& mesh) {
-  num_nodes_ = mesh.num_nodes();
-  elements_ = mesh.elements;
-  for (const auto& el : elements_)
-    for (int a : el)
-      if (a < 0 || a >= num_nodes_) throw std::invalid_argument("stokes: element refers to a missing node");
-  if (static_cast<int>(mesh.node_element_offsets.size()) != num_nodes_ + 1)
-    throw std::invalid_argument("stokes: mesh node→element offsets have the wrong size");
-  node_offsets_ = mesh.node_element_offsets;
-  inc_element_.resize(mesh.node_elements.size());
-  inc_local_.resize(mesh.node_elements.size());
-  for (int i = 0; i < num_nodes_; ++i) {
-    for (int k = node_offsets_[i]; k < node_offsets_[i + 1]; ++k) {
-      const int e = mesh.node_elements[k];
-      const auto& el = elements_.at(e);
-      const auto it = std::find(el.begin(), el.end(), i);
-      if (it == el.end()) throw std::invalid_argument("stokes: node→element list inconsistent with elements");
-      inc_element_[k] = e;
-      inc_local_[k] = static_cast<int>(it - el.begin());
-    }
-  }
-  if (static_cast<int>(mesh.mirror_node.size()) == num_nodes_) mirror_ = mesh.mirror_node;
-  if (static_cast<int>(mesh.central_node.size()) == num_nodes_) central_ = mesh.central_node;
-  // Targets in the order of their first element: the mesh's elements come from recursive subdivision
-  // (children of one parent are consecutive), so this order is spatially coherent and consecutive targets
-  // of the correction loops read the same neighbouring elements from cache. Each target's own sums do not
-  // depend on the order, so neither does u.
-  std::vector<int> first(static_cast<std::size_t>(num_nodes_), 0);
-  for (int i = 0; i < num_nodes_; ++i) {
-    first[i] = num_nodes_ > 0 && node_offsets_[i] < node_offsets_[i + 1] ? inc_element_[node_offsets_[i]] : 0;
-    for (int k = node_offsets_[i]; k < node_offsets_[i + 1]; ++k) first[i] = std::min(first[i], inc_element_[k]);
-  }
-  node_order_.resize(static_cast<std::size_t>(num_nodes_));
-  for (int i = 0; i < num_nodes_; ++i) node_order_[i] = i;
-  std::stable_sort(node_order_.begin(), node_order_.end(), [&](int a, int b) { return first[a] < first[b]; });
-}
-
-bool SingleLayer::symmetric_scene(const std::vector<int>& image, const std::array<double, 3>& signs,
-                                  const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) const {
-  if (image.empty() || x.cols() != num_nodes_ || q.cols() != num_nodes_) return false;
-  const double lx = (x.rowwise().maxCoeff() - x.rowwise().minCoeff()).norm();
-  const double lq = q.colwise().norm().maxCoeff();
-  return mesh::symmetric_under(image, signs, x, opt_.symmetry_tol * lx) &&
-         mesh::symmetric_under(image, signs, q, opt_.load_symmetry_tol * lq);
-}
-
 bool SingleLayer::is_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) const {
-  return symmetric_scene(mirror_, mesh::kMirrorSigns, x, q);
+  return x.cols() == topo_.num_nodes &&
+         symmetric_scene(topo_.mirror, mesh::kMirrorSigns, x, q, opt_.symmetry_tol, opt_.load_symmetry_tol);
 }
 
 bool SingleLayer::is_centrally_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) const {
-  return symmetric_scene(central_, mesh::kCentralSigns, x, q);
+  return x.cols() == topo_.num_nodes &&
+         symmetric_scene(topo_.central, mesh::kCentralSigns, x, q, opt_.symmetry_tol, opt_.load_symmetry_tol);
 }
 
 kernel::Sources SingleLayer::build_sources(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) {
-  layout_points(regular_, elements_, x, q, kernel::simd_width(), sources_);
+  layout_points(regular_, topo_.elements, x, q, kernel::simd_width(), sources_);
   return sources_.sources();
 }
 
 void SingleLayer::select_targets(const Eigen::Matrix3Xd& x, bool symmetric, bool central) {
-  // All nodes, or one of each mirror pair (the one with the larger x3; a node on the plane is its own
-  // image and is evaluated), or with the central symmetry one of each orbit (its smallest index).
-  target_ids_.clear();
-  for (const int i : node_order_) {
-    if (central) {
-      const int p = central_[i], m = symmetric ? mirror_[i] : i, r = symmetric ? mirror_[p] : i;
-      if (std::min({m, p, r}) < i) continue;
-    } else if (symmetric) {
-      const int m = mirror_[i];
-      const bool mine = m == i || x(2, i) > x(2, m) || (x(2, i) == x(2, m) && i < m);
-      if (!mine) continue;
-    }
-    target_ids_.push_back(i);
-  }
+  target_ids_ = orbit_targets(topo_, x, symmetric, central);
   const int nt = static_cast<int>(target_ids_.size());
   for (auto* v : {&tx_, &ty_, &tz_, &ux_, &uy_, &uz_}) v->resize(static_cast<std::size_t>(nt));
   for (int k = 0; k < nt; ++k) {
@@ -229,7 +172,7 @@ void SingleLayer::regular_sum(const kernel::Sources& src, Eigen::Matrix3Xd& u) {
     kernel::sum_mixed(tg, src, res);
   else
     kernel::sum_fast(tg, src, res, opt_.fast);
-  u.resize(3, num_nodes_);
+  u.resize(3, topo_.num_nodes);
   for (int k = 0; k < nt; ++k) {
     u(0, target_ids_[k]) = ux_[k];
     u(1, target_ids_[k]) = uy_[k];
@@ -241,13 +184,13 @@ long long SingleLayer::far_field(const Eigen::Matrix3Xd& x, const Eigen::Matrix3
   // Mid elements (and the own/near ones) upgraded from the coarse to the regular rule. The singular
   // correction then finds the regular points of each element in the mid layout (first nq of each block)
   // instead of the all-pairs sources.
-  grid_.build(x, elements_, opt_.far_radius);
+  grid_.build(x, topo_.elements, opt_.far_radius);
   layout_points(mid_rule_, grid_.sorted_elements, x, q, 1, mid_points_);
   regular_points_ = &mid_points_;
   regular_stride_ = static_cast<int>(mid_rule_.size());
   regular_slot_ = grid_.slot.data();
-  return add_mid_blocks(grid_, mid_points_, static_cast<int>(mid_rule_.size()), node_offsets_, inc_element_, near_,
-                        target_ids_, x, mid_scratch_, u);
+  return add_mid_blocks(grid_, mid_points_, static_cast<int>(mid_rule_.size()), topo_.node_offsets,
+                        topo_.inc_element, near_, target_ids_, x, mid_scratch_, u);
 }
 
 void SingleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) {
@@ -267,8 +210,8 @@ void SingleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Ma
       double X[6][3], F[6][3];
       for (int a = 0; a < 6; ++a)
         for (int c = 0; c < 3; ++c) {
-          X[a][c] = x(c, elements_[e][a]);
-          F[a][c] = q(c, elements_[e][a]);
+          X[a][c] = x(c, topo_.elements[e][a]);
+          F[a][c] = q(c, topo_.elements[e][a]);
         }
       double* m = element_monomials_.data() + static_cast<std::size_t>(e) * 36;
       mesh::p2_monomials3(X, reinterpret_cast<double(*)[3]>(m));
@@ -280,9 +223,9 @@ void SingleLayer::singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Ma
     const int i = target_ids_[it];
     const double x0[3] = {x(0, i), x(1, i), x(2, i)};
     double acc[3] = {0.0, 0.0, 0.0};
-    for (int k = node_offsets_[i]; k < node_offsets_[i + 1]; ++k) {
-      const int e = inc_element_[k], l = inc_local_[k];
-      const auto& el = elements_[e];
+    for (int k = topo_.node_offsets[i]; k < topo_.node_offsets[i + 1]; ++k) {
+      const int e = topo_.inc_element[k], l = topo_.inc_local[k];
+      const auto& el = topo_.elements[e];
       // Remove what the regular rule counted for this element ...
       const int b = (slot != nullptr ? slot[e] : e) * stride;
       add_block(x0, reg, b, b + nq, -1.0, acc);
@@ -367,39 +310,12 @@ void SingleLayer::mirror(Eigen::Matrix3Xd& u) const {
   // moves such nodes off the plane by more than symmetry_tol within a few steps, and every later evaluation
   // loses the symmetry (twice the targets: measured 1.06× instead of 1.7× on a level-3 case). The symmetry
   // says u3 = 0 there exactly; in double the same u3 is round-off and left as it is (bit for bit unchanged).
-  const bool on_plane_zero = uses_mixed_precision();
-  for (const int i : target_ids_) {
-    const int m = mirror_[i];
-    if (m == i) {
-      if (on_plane_zero) u(2, i) = 0.0;
-      continue;
-    }
-    u(0, m) = u(0, i);
-    u(1, m) = u(1, i);
-    u(2, m) = -u(2, i);
-  }
-}
-
-void SingleLayer::expand_central(Eigen::Matrix3Xd& u, bool symmetric) const {
-  // u(−x0) = −u(x0), and with the mirror M u(M x0) = M u(x0), so on the half-turn R = M P about x3
-  // u(R x0) = R u(x0). A node fixed by M (on the plane) or by R (on the x3 axis) gets the components the
-  // symmetry sets to zero set exactly: the sums give them as round-off in double and ≈ 1e-7 |u| in mixed
-  // precision, which would move such a node off its plane or axis and lose the symmetry (see mirror()).
-  for (const int i : target_ids_) {
-    const int p = central_[i], m = symmetric ? mirror_[i] : i, r = symmetric ? mirror_[p] : i;
-    if (symmetric && m == i) u(2, i) = 0.0;
-    if (symmetric && r == i) u(0, i) = u(1, i) = 0.0;
-    const double a = u(0, i), b = u(1, i), c = u(2, i);
-    if (symmetric) u(0, r) = -a, u(1, r) = -b, u(2, r) = c;
-    u(0, p) = -a, u(1, p) = -b, u(2, p) = -c;
-    if (symmetric) u(0, m) = a, u(1, m) = b, u(2, m) = -c;
-    u(0, i) = a, u(1, i) = b, u(2, i) = c;  // last: a member that is its own image keeps its value
-  }
+  expand_mirror(topo_, target_ids_, uses_mixed_precision(), u);
 }
 
 void SingleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Eigen::Matrix3Xd& u) {
-  if (x.cols() != num_nodes_ || q.cols() != num_nodes_)
-    throw std::invalid_argument("stokes: x and q must have " + std::to_string(num_nodes_) + " columns (got " +
+  if (x.cols() != topo_.num_nodes || q.cols() != topo_.num_nodes)
+    throw std::invalid_argument("stokes: x and q must have " + std::to_string(topo_.num_nodes) + " columns (got " +
                                 std::to_string(x.cols()) + " and " + std::to_string(q.cols()) + ")");
   const double t0 = now_s();
   bool sym = false;
@@ -411,8 +327,8 @@ void SingleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Ei
   const bool central = opt_.central_symmetry && opt_.symmetry != Symmetry::Off && is_centrally_symmetric(x, q);
   // 1. Layout: with the far-field tier the all-pairs sum runs over the coarse rule, else the regular rule.
   const bool far = opt_.far_degree > 0;
-  layout_points(far ? coarse_ : regular_, elements_, x, q, kernel::simd_width(), sources_);
-  if (!near_rule_.empty()) layout_points(near_rule_, elements_, x, q, 1, near_points_);
+  layout_points(far ? coarse_ : regular_, topo_.elements, x, q, kernel::simd_width(), sources_);
+  if (!near_rule_.empty()) layout_points(near_rule_, topo_.elements, x, q, 1, near_points_);
   regular_points_ = &sources_;
   regular_stride_ = rule_size_;
   regular_slot_ = nullptr;
@@ -430,7 +346,7 @@ void SingleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Ei
   near_correction(u);
   // 5. Symmetries: u at the nodes not evaluated.
   if (central)
-    expand_central(u, sym);
+    expand_central(topo_, target_ids_, sym, u);
   else if (sym)
     mirror(u);
   const double t4 = now_s();

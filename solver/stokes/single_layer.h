@@ -59,6 +59,7 @@
 
 #include "solver/mesh/mesh.h"
 #include "solver/mesh/p2_tabulation.h"
+#include "solver/stokes/boundary_mesh.h"
 #include "solver/stokes/far_field.h"
 #include "solver/stokes/near_singular.h"
 #include "solver/stokes/singular_rules.h"
@@ -166,8 +167,8 @@ class SingleLayer {
   /// evaluation order.
   [[nodiscard]] const std::vector<int>& last_targets() const { return target_ids_; }
   [[nodiscard]] const SingleLayerOptions& options() const { return opt_; }
-  [[nodiscard]] int num_nodes() const { return num_nodes_; }
-  [[nodiscard]] int num_elements() const { return static_cast<int>(elements_.size()); }
+  [[nodiscard]] int num_nodes() const { return topo_.num_nodes; }
+  [[nodiscard]] int num_elements() const { return static_cast<int>(topo_.elements.size()); }
   /// @brief Quadrature points of the regular rule over the whole surface (sources of the hot loop).
   [[nodiscard]] int num_quadrature_points() const { return num_elements() * rule_size_; }
 
@@ -176,13 +177,7 @@ class SingleLayer {
   kernel::Sources build_sources(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q);
 
  private:
-  // Constructor phase: connectivity copied from the mesh (checked), node → (element, local index).
-  void copy_connectivity(const mesh::SurfaceMesh& mesh);
   // apply() phases (see the file comment).
-  // Whether positions and loads map onto themselves under the node map `image` with the sign pattern `signs`,
-  // to symmetry_tol and load_symmetry_tol (the checks of is_symmetric, is_centrally_symmetric).
-  [[nodiscard]] bool symmetric_scene(const std::vector<int>& image, const std::array<double, 3>& signs,
-                                     const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q) const;
   void select_targets(const Eigen::Matrix3Xd& x, bool symmetric, bool central);
   void regular_sum(const kernel::Sources& src, Eigen::Matrix3Xd& u);
   long long far_field(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Eigen::Matrix3Xd& u);
@@ -191,8 +186,6 @@ class SingleLayer {
   void singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q);
   void near_correction(Eigen::Matrix3Xd& u);
   void mirror(Eigen::Matrix3Xd& u) const;
-  // With the central symmetry: u at every member of each evaluated orbit (mirror too when `symmetric`).
-  void expand_central(Eigen::Matrix3Xd& u, bool symmetric) const;
   // Whether float pair terms are in use (KernelPrecision::Mixed with the fast kernel): the regular sum and the
   // Duffy terms in float, u3 = 0 set on the mirror plane.
   [[nodiscard]] bool uses_mixed_precision() const {
@@ -200,14 +193,8 @@ class SingleLayer {
   }
 
   SingleLayerOptions opt_;
-  int num_nodes_ = 0;
+  BoundaryMesh topo_;                       // connectivity, incidence, symmetry maps, target order
   int rule_size_ = 0;
-  std::vector<std::array<int, 6>> elements_;
-  std::vector<int> node_offsets_;           // node → incidences CSR
-  std::vector<int> inc_element_, inc_local_;
-  std::vector<int> mirror_;                 // empty if the mesh has none
-  std::vector<int> central_;                // image under x → −x; empty if the mesh has none
-  std::vector<int> node_order_;             // nodes in the order targets are evaluated (spatially coherent)
   std::vector<mesh::P2Point> regular_;      // rule points
   PointTable duffy_[6];                     // Duffy rule per local node position (SoA)
   ApexTableF duffy_f_[6];                   // the same in float about the apex (mixed precision only)

@@ -202,6 +202,22 @@ inline void add_stokeslet(T rx, T ry, T rz, T qx, T qy, T qz, T inv_r, T w, T& u
   add_stokeslet_scaled(rx, ry, rz, qx, qy, qz, inv_r * inv_r, w * inv_r, ux, uy, uz);
 }
 
+/// @brief The stresslet (double-layer kernel) applied to a density and a weighted normal, the one scalar
+/// definition used by every double-layer loop (solver/stokes/double_layer.h):
+///     u_j += d_i T_ijk(r) n_k = −6 (d·r)(r·n) r_j / |r|⁵,   T_ijk(r) = −6 r_i r_j r_k / |r|⁵,   r = x − x0,
+/// with r from the target x0 to the source x (the sign convention of solver/README.md §3b: T is odd in r), d the
+/// density at the source (the double layer passes v(x) − v(x0)) and n the normal at the source times its weight
+/// and area element. inv_r = 1/|r| is supplied by the caller (inv_r = 0 masks a pair at zero distance). T is
+/// double or float (inside `omp simd` loops) or long double (test references).
+template <class T>
+inline void add_stresslet(T rx, T ry, T rz, T dx, T dy, T dz, T nx, T ny, T nz, T inv_r, T& ux, T& uy, T& uz) {
+  const T inv_r2 = inv_r * inv_r;
+  const T s = T(-6) * (dx * rx + dy * ry + dz * rz) * (nx * rx + ny * ry + nz * rz) * (inv_r2 * inv_r2 * inv_r);
+  ux += s * rx;
+  uy += s * ry;
+  uz += s * rz;
+}
+
 /// @brief W target lanes against the sources [j0, j1) in precision T, accumulated into a (the portable tiles of
 /// sum_fast and sum_mixed, for machines without AVX2: the lane loop is what the compiler vectorises).
 template <class T, int W>

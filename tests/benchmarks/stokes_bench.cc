@@ -1,5 +1,6 @@
 // Boundary-integral flow benchmarks: the full single-layer evaluation at
-// levels 2, 3, 4 next to the same evaluation with the plain reference loop, and the bare Stokeslet sums
+// levels 2, 3, 4 next to the same evaluation with the plain reference loop and the double layer of the same density
+// (stokes/double_layer.h), and the bare Stokeslet sums
 // (fast kernel variants and plain loop) in the same run. items_per_second = Stokeslet interactions/s.
 // After the Google benchmarks, a far-field-tier table (SingleLayerOptions::far_degree / far_radius): wall
 // time and error against the full rule on a deformed surface, and the discretisation error of the sphere
@@ -22,6 +23,7 @@
 #include <Eigen/Core>
 
 #include "solver/mesh/mesh.h"
+#include "solver/stokes/double_layer.h"
 #include "solver/stokes/kernel_problem.h"
 #include "solver/stokes/single_layer.h"
 #include "solver/stokes/stokeslet.h"
@@ -40,13 +42,10 @@ Eigen::Matrix3Xd test_load(const Eigen::Matrix3Xd& x, bool symmetric) {
   return q;
 }
 
-void single_layer(benchmark::State& state, stokes::KernelChoice kernel, bool symmetric) {
-  const auto mesh = mesh::make_sphere_mesh(static_cast<int>(state.range(0)));
-  stokes::SingleLayerOptions opt;
-  opt.kernel = kernel;
-  opt.symmetry = symmetric ? stokes::Symmetry::On : stokes::Symmetry::Off;
-  stokes::SingleLayer op(mesh, opt);
-  const Eigen::Matrix3Xd q = test_load(mesh.nodes, symmetric);
+// One boundary operator's evaluations (SingleLayer or DoubleLayer: the same stats fields) on the sphere mesh,
+// with the phase times as counters. items_per_second = target × regular-source pairs per second.
+template <class Op>
+void run_operator(benchmark::State& state, Op& op, const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& q) {
   Eigen::Matrix3Xd u;
   double regular = 0, singular = 0, build = 0;
   for (auto _ : state) {
@@ -64,8 +63,27 @@ void single_layer(benchmark::State& state, stokes::KernelChoice kernel, bool sym
   state.counters["singular_ms"] = 1e3 * singular / n;
   state.counters["threads"] = omp_get_max_threads();
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(op.last_stats().targets) *
-                          op.num_quadrature_points());
+                          mesh.num_elements() * mesh::P2Tabulation::of_degree(op.options().regular_degree).size());
 }
+
+void single_layer(benchmark::State& state, stokes::KernelChoice kernel, bool symmetric) {
+  const auto mesh = mesh::make_sphere_mesh(static_cast<int>(state.range(0)));
+  stokes::SingleLayerOptions opt;
+  opt.kernel = kernel;
+  opt.symmetry = symmetric ? stokes::Symmetry::On : stokes::Symmetry::Off;
+  stokes::SingleLayer op(mesh, opt);
+  run_operator(state, op, mesh, test_load(mesh.nodes, symmetric));
+}
+
+// The double layer of the same density on the same mesh (all targets; its regular sum: targets in lanes, omp simd).
+void BM_DoubleLayer(benchmark::State& state) {
+  const auto mesh = mesh::make_sphere_mesh(static_cast<int>(state.range(0)));
+  stokes::SingleLayerOptions opt;
+  opt.symmetry = stokes::Symmetry::Off;
+  stokes::DoubleLayer op(mesh, opt);
+  run_operator(state, op, mesh, test_load(mesh.nodes, false));
+}
+BENCHMARK(BM_DoubleLayer)->DenseRange(2, 4)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_SingleLayerFast(benchmark::State& s) { single_layer(s, stokes::KernelChoice::Fast, false); }
 void BM_SingleLayerPlain(benchmark::State& s) { single_layer(s, stokes::KernelChoice::Plain, false); }

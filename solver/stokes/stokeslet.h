@@ -185,7 +185,7 @@ inline float rsqrt_arith(float x) {
 /// @brief The Stokeslet applied to a load, the one scalar definition used by every non-SIMD path:
 ///     u += f · (q + r (r·q) / r²),   i.e. u += w · J(r)·q with f = w / |r|,   r = x0 − x,
 /// with inv_r2 = 1/r² and f supplied by the caller (each caller chooses how to compute them; inv_r2 = f = 0
-/// masks a pair at zero distance). (r·q) · inv_r2 is the operation order of the SIMD tiles in stokeslet.cc.
+/// masks a pair at zero distance). (r·q) · inv_r2 is the operation order of the SIMD tiles (stokeslet_lanes.h).
 /// T is double or float (inside `omp simd` loops, where it vectorises once inlined) or long double (test
 /// references).
 template <class T>

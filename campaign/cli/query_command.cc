@@ -1,5 +1,4 @@
 // `capsim query table1|cases|sql`: read-only queries of a campaign database.
-#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 #include <algorithm>
 #include <cmath>
@@ -11,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "campaign/cli/cli_app.h"
 #include "campaign/cli/commands.h"
 #include "campaign/analysis/uncertainty.h"
 #include "campaign/common/bad_input.h"
@@ -250,14 +250,7 @@ int query_command(const std::vector<std::string>& args) {
   std::string text;
   sq->add_option("statement", text, "SQL text, e.g. \"SELECT * FROM transitions\"")->required();
 
-  std::vector<std::string> rev(args.rbegin(), args.rend());
-  try {
-    app.parse(rev);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::fprintf(stderr, "capsim query: %s (see capsim query --help)\n", e.what());
-    return kExitBadInput;
-  }
+  if (const auto code = parse_args(app, args)) return *code;
   try {
     const auto fmt = campaign::parse_format(format);
     auto store = campaign::Store::open_readonly(db);

@@ -23,7 +23,7 @@ void print_usage() {
       "  capsim campaign collect --db FILE\n"
       "  capsim campaign import --db FILE --from OTHER.sqlite [--campaign NAME] [--dry-run]\n"
       "  capsim campaign status --db FILE\n"
-      "  capsim query table1|cases|sql ... --db FILE [--format md|csv|json]\n"
+      "  capsim query table1|cases|transitions|sql ... --db FILE [--format md|csv|json]\n"
       "  capsim bench kernel [--json] [--threads T] [--repeat R]\n"
       "  capsim bench flow [--set key=value]... [--level L] [--bending KB] [--precision double|mixed] [--json]\n"
       "                    [--threads T] [--repeat R]\n"

@@ -23,7 +23,7 @@ int lines_of(const std::string& s) {
 // Every sub-command, as typed after `capsim`.
 const std::vector<std::string> kCommands = {
     "run", "_summary", "campaign", "campaign run", "campaign submit", "campaign collect", "campaign import",
-    "campaign analyse", "campaign status", "query", "query table1", "query cases", "query sql",
+    "campaign analyse", "campaign status", "query", "query table1", "query cases", "query transitions", "query sql",
     "bench", "bench kernel", "bench flow", "keys"};
 
 TEST(Grammar, EverySubcommandAnswersHelp) {

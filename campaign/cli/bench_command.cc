@@ -1,9 +1,11 @@
 // `capsim bench kernel [--json] [--threads N] [--repeat R]`: the Stokeslet kernel on a level-3-sized problem
 // (2562 targets × all regular quadrature points of the level-3 sphere), fast kernel against the plain
-// `omp simd` loop, so users can check a new machine (issue 6 §1).
-// `capsim bench flow [--level L] [--bending KB] [--precision double|mixed] [--json] [--threads N] [--repeat R]`: one
-// flow evaluation by named phase against the bare regular Stokeslet sum in the same run
-// (solver/dynamics/flow_benchmark.h, issue 13 §1); with --precision mixed also against the double evaluation.
+// `omp simd` loop, so users can check a new machine.
+// `capsim bench flow [--set KEY=VALUE]... [--level L] [--bending KB] [--precision double|mixed] [--json]
+// [--threads N] [--repeat R]`: one flow evaluation by named phase against the bare regular Stokeslet sum in the
+// same run (solver/dynamics/flow_benchmark.h); with numerics.kernel_precision = mixed also against the double
+// evaluation. The scene is a case: any case key reaches it through --set; --level, --bending and --precision
+// are shorthands for three of them.
 #include <omp.h>
 
 #include <algorithm>
@@ -15,7 +17,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "campaign/cli/cli_app.h"
 #include "campaign/cli/commands.h"
+#include "solver/config/case_config.h"
 #include "solver/dynamics/flow_benchmark.h"
 #include "solver/stokes/kernel_problem.h"
 #include "solver/stokes/stokeslet.h"
@@ -24,25 +28,6 @@ namespace capsim::cli {
 namespace {
 
 namespace sk = capsim::stokes::kernel;
-
-void usage_error(const std::string& msg) {
-  std::fprintf(stderr,
-               "capsim bench: %s (usage: capsim bench kernel [--json] [--threads N] [--repeat R]; "
-               "capsim bench flow [--level L] [--bending KB] [--precision double|mixed] [--json] [--threads N] [--repeat R])\n",
-               msg.c_str());
-}
-
-bool parse_positive_int(const std::string& s, int& out) {
-  try {
-    std::size_t pos = 0;
-    const long v = std::stol(s, &pos);
-    if (pos != s.size() || v < 1 || v > 1000000) return false;
-    out = static_cast<int>(v);
-    return true;
-  } catch (...) {
-    return false;
-  }
-}
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -74,69 +59,26 @@ double max_rel_error(const std::vector<double>& ux, const std::vector<double>& u
   return e;
 }
 
+// The options of both benchmarks; the scene's keys only for `flow`.
 struct BenchArgs {
   bool json = false;
-  int threads = 0, repeat = 0, level = 3;
-  double bending = 0.0;
-  std::string precision = "double";
+  int threads = 0, repeat = 0;
+  std::vector<std::string> overrides;  ///< shorthands and --set, in this order (a later one wins)
 };
-
-// Parses the options after the benchmark's name; `level` only where allowed. False after a usage error.
-bool parse_args(const std::vector<std::string>& args, bool allow_level, BenchArgs& out) {
-  for (std::size_t k = 1; k < args.size(); ++k) {
-    const std::string& a = args[k];
-    if (a == "--json") {
-      out.json = true;
-    } else if (allow_level && a == "--bending") {
-      std::size_t used = 0;
-      double v = -1;
-      try {
-        if (k + 1 < args.size()) v = std::stod(args[k + 1], &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (k + 1 >= args.size() || used != args[k + 1].size()) {
-        usage_error("--bending needs a number (capsule.bending_modulus)");
-        return false;
-      }
-      out.bending = v;  // its range is the key registry's, checked by FlowBenchOptions::valid
-      ++k;
-    } else if (allow_level && a == "--precision") {
-      if (k + 1 >= args.size()) {
-        usage_error("--precision needs a value (numerics.kernel_precision)");
-        return false;
-      }
-      out.precision = args[++k];  // checked by FlowBenchOptions::valid against the key registry
-    } else if (a == "--threads" || a == "--repeat" || (allow_level && a == "--level")) {
-      if (k + 1 >= args.size()) {
-        usage_error(a + " needs a value");
-        return false;
-      }
-      int v = 0;
-      if (!parse_positive_int(args[k + 1], v)) {
-        usage_error(a + " must be a positive integer, got '" + args[k + 1] + "'");
-        return false;
-      }
-      (a == "--threads" ? out.threads : a == "--repeat" ? out.repeat : out.level) = v;
-      ++k;
-    } else {
-      usage_error("unknown option '" + a + "'");
-      return false;
-    }
-  }
-  return true;
-}
-
 int bench_flow(const BenchArgs& ba) {
   capsim::dynamics::FlowBenchOptions opt;
-  opt.level = ba.level;
   opt.repeat = ba.repeat;
-  opt.bending_modulus = ba.bending;
-  opt.kernel_precision = ba.precision;
-  if (std::string why; !opt.valid(&why)) {
-    usage_error(why);
+  try {
+    opt.scene = capsim::dynamics::FlowBenchOptions::scene_with(ba.overrides);
+  } catch (const config::ConfigError& e) {
+    std::fprintf(stderr, "capsim bench flow: %s\n", e.what());
     return kExitBadInput;
   }
+  if (std::string why; !opt.valid(&why)) {
+    std::fprintf(stderr, "capsim bench flow: %s\n", why.c_str());
+    return kExitBadInput;
+  }
+  const config::CaseConfig& scene = opt.scene;
   if (ba.threads > 0) omp_set_num_threads(ba.threads);
   const capsim::dynamics::FlowBenchReport r = capsim::dynamics::bench_flow(opt);
   if (ba.json) {
@@ -163,13 +105,14 @@ int bench_flow(const BenchArgs& ba) {
                         {"near_ms", s.near_ms},
                         {"volume_ms", s.volume_ms},
                         {"other_ms", s.other_ms}});
-    // The symmetric scene's fields also at the top level: the figure the issue's goal is stated in.
+    // The symmetric scene's fields also at the top level: the scene of every run that starts in the shear plane.
     const auto& sym = r.scenes.front();
     const nlohmann::json j = {{"level", r.level},
                               {"nodes", sym.nodes},
                               {"threads", r.threads},
                               {"kernel_isa", r.isa},
-                              {"kernel_precision", ba.precision},
+                              {"kernel_precision", scene.kernel_precision},
+                              {"overrides", ba.overrides},
                               {"evaluation_ms", sym.evaluation_ms},
                               {"evaluation_double_ms", sym.evaluation_double_ms},
                               {"regular_sum_ms", sym.regular_sum_ms},
@@ -178,9 +121,10 @@ int bench_flow(const BenchArgs& ba) {
     std::printf("%s\n", j.dump().c_str());
     return 0;
   }
-  std::printf("Flow evaluation, level %d (%d nodes), a/b = 2 Skalak Ca = 0.3 deformed, bending modulus %g, %d "
+  std::printf("Flow evaluation, level %d (%d nodes), a/b = %g %s Ca = %g deformed, bending modulus %g, %d "
               "thread(s), kernel %s\n",
-              r.level, r.scenes.front().nodes, ba.bending, r.threads, r.isa.c_str());
+              r.level, r.scenes.front().nodes, scene.aspect_ratio, scene.law.c_str(), scene.capillary_number,
+              scene.bending_modulus, r.threads, r.isa.c_str());
   std::printf("%-10s %7s %9s %9s %8s | %8s %8s %8s %8s %8s %8s %8s %8s %8s %8s\n", "scene", "targets", "eval ms",
               "bare ms", "ratio", "membrane", "bending", "load", "layout", "regular", "far", "singular", "near",
               "volume", "other");
@@ -192,25 +136,15 @@ int bench_flow(const BenchArgs& ba) {
   std::printf("ratio = evaluation / bare regular sum (double) over the same targets and sources (medians of %d, "
               "alternated); phases are means per evaluation in ms\n",
               r.scenes.front().repeat);
-  if (ba.precision != "double")
+  if (scene.kernel_precision != "double")
     for (const auto& s : r.scenes)
       std::printf("%s: %s evaluation %.3f ms, double %.3f ms (alternated in this run): %.2fx faster\n", s.name.c_str(),
-                  ba.precision.c_str(), s.evaluation_ms, s.evaluation_double_ms,
+                  scene.kernel_precision.c_str(), s.evaluation_ms, s.evaluation_double_ms,
                   s.evaluation_double_ms / s.evaluation_ms);
   return 0;
 }
 
-}  // namespace
-
-int bench_command(const std::vector<std::string>& args) {
-  const bool known = !args.empty() && (args[0] == "kernel" || args[0] == "flow");
-  if (!known) {
-    usage_error(args.empty() ? "missing benchmark name" : "unknown benchmark '" + args[0] + "'");
-    return kExitBadInput;
-  }
-  BenchArgs ba;
-  if (!parse_args(args, args[0] == "flow", ba)) return kExitBadInput;
-  if (args[0] == "flow") return bench_flow(ba);
+int bench_kernel(const BenchArgs& ba) {
   const bool json = ba.json;
   const int repeat = ba.repeat > 0 ? ba.repeat : 20;
   if (ba.threads > 0) omp_set_num_threads(ba.threads);
@@ -285,6 +219,44 @@ int bench_command(const std::vector<std::string>& args) {
                  mixed8_err <= sk::kMixedRelativeBound
              ? 0
              : 1;  // the kernels' contracts
+}
+
+// Declares the options both benchmarks take.
+void add_common_options(CLI::App& sub, BenchArgs& ba) {
+  sub.add_flag("--json", ba.json, "print the measurement as one JSON line");
+  add_threads_option(sub, ba.threads);
+  sub.add_option("--repeat", ba.repeat, "timed repetitions (default: automatic)")->check(CLI::Range(1, 1000000));
+}
+
+}  // namespace
+
+int bench_command(const std::vector<std::string>& args) {
+  CLI::App app{"capsim bench: measure this machine", "capsim bench"};
+  app.require_subcommand(1);
+  BenchArgs ba;
+  auto* kernel = app.add_subcommand(
+      "kernel", "the Stokeslet kernel on the level-3 sphere: fast and mixed-precision sums against the plain loop");
+  add_common_options(*kernel, ba);
+  auto* flow = app.add_subcommand(
+      "flow", "one flow evaluation by named phase against the bare regular Stokeslet sum, in three scenes "
+              "(symmetric, general, central) of a capsule given by case keys");
+  add_common_options(*flow, ba);
+  // The shorthands are case keys: each becomes the override it names, checked by the key registry as --set is.
+  auto shorthand = [&](const char* name, const char* key, const char* what) {
+    flow->add_option_function<std::string>(
+        name, [&ba, key](const std::string& v) { ba.overrides.push_back(std::string(key) + "=" + v); },
+        std::string(what) + " (= --set " + key + "=VALUE)");
+  };
+  shorthand("--level", "mesh.level", "mesh level of the scene");
+  shorthand("--bending", "capsule.bending_modulus", "bending modulus of the scene");
+  shorthand("--precision", "numerics.kernel_precision", "double or mixed (mixed: also measured in double)");
+  std::vector<std::string> sets;
+  add_set_option(*flow, sets)->description("override one case key of the scene: section.key=value (repeatable; "
+                                            "after the shorthands)");
+  if (const auto code = parse_args(app, args)) return *code;
+  if (*kernel) return bench_kernel(ba);
+  ba.overrides.insert(ba.overrides.end(), sets.begin(), sets.end());
+  return bench_flow(ba);
 }
 
 }  // namespace capsim::cli

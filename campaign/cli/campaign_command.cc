@@ -1,5 +1,4 @@
 // `capsim campaign run|submit|collect|import|analyse|status`: the campaign manager's command line.
-#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
@@ -11,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "campaign/cli/cli_app.h"
 #include "campaign/cli/commands.h"
 #include "campaign/common/bad_input.h"
 #include "campaign/grid/decimal.h"
@@ -306,14 +306,7 @@ int campaign_command(const std::vector<std::string>& args) {
   st->add_option("--db", status_db, "SQLite results database")->required();
   st->add_option("--campaign", status_name, "only this campaign");
 
-  std::vector<std::string> rev(args.rbegin(), args.rend());
-  try {
-    app.parse(rev);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::fprintf(stderr, "capsim campaign: %s (see capsim campaign --help)\n", e.what());
-    return kExitBadInput;
-  }
+  if (const auto code = parse_args(app, args)) return *code;
   try {
     if (*run) {
       if (opt.jobs < 0 || opt.threads_per_job < 0 || (run->count("--jobs") && opt.jobs == 0) ||

@@ -22,13 +22,13 @@ int summary_command(const std::vector<std::string>& args);
 /// @brief `capsim campaign run|status|...`.
 int campaign_command(const std::vector<std::string>& args);
 
-/// @brief `capsim query table1|cases|sql ... --db FILE [--format md|csv|json]`.
+/// @brief `capsim query table1|cases|transitions|sql ... --db FILE [--format md|csv|json]`.
 int query_command(const std::vector<std::string>& args);
 
 /// @brief `capsim keys --format md`: the case-key table of schemas/case_keys.md, from the registry.
 int keys_command(const std::vector<std::string>& args);
 
-/// @brief `capsim bench kernel [--json]`.
+/// @brief `capsim bench kernel|flow [--json] [--threads N] [--repeat R]`; flow also takes `--set key=value`.
 int bench_command(const std::vector<std::string>& args);
 
 }  // namespace capsim::cli

@@ -23,11 +23,13 @@ void print_usage() {
       "  capsim campaign collect --db FILE\n"
       "  capsim campaign import --db FILE --from OTHER.sqlite [--campaign NAME] [--dry-run]\n"
       "  capsim campaign status --db FILE\n"
-      "  capsim query table1|cases|sql ... --db FILE [--format md|csv|json]\n"
-      "  capsim bench kernel [--json]\n"
-      "  capsim bench flow [--level L] [--threads T] [--json]\n"
+      "  capsim query table1|cases|transitions|sql ... --db FILE [--format md|csv|json]\n"
+      "  capsim bench kernel [--json] [--threads T] [--repeat R]\n"
+      "  capsim bench flow [--set key=value]... [--level L] [--bending KB] [--precision double|mixed] [--json]\n"
+      "                    [--threads T] [--repeat R]\n"
       "  capsim keys --format md\n"
-      "  capsim --version\n",
+      "  capsim --version\n"
+      "every command answers --help\n",
       capsim::kVersion, capsim::kGitCommit);
 }
 

@@ -1,5 +1,4 @@
-// `capsim query table1|cases|sql`: read-only queries of a campaign database.
-#include <CLI/CLI.hpp>
+// `capsim query table1|cases|transitions|sql`: read-only queries of a campaign database.
 #include <nlohmann/json.hpp>
 #include <algorithm>
 #include <cmath>
@@ -11,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "campaign/cli/cli_app.h"
 #include "campaign/cli/commands.h"
 #include "campaign/analysis/uncertainty.h"
 #include "campaign/common/bad_input.h"
@@ -50,6 +50,38 @@ double bending_modulus_of(const std::string& group_key) {
   if (j.is_object() && j.contains("capsule.bending_modulus") && j["capsule.bending_modulus"].is_number())
     return j["capsule.bending_modulus"].get<double>();
   return 0.0;
+}
+
+// Every stored field of @p rows (of campaign @p campaign_of[i]) as the JSON and CSV of `query table1` and
+// `query transitions` give them. The first eighteen columns are those table1 has always had, in their order:
+// the fields added since come after them, so that readers of the older output read the newer one.
+campaign::Table transitions_table(const std::vector<campaign::Transition>& rows,
+                                  const std::vector<std::string>& campaign_of) {
+  campaign::Table t;
+  t.columns = {"law",          "aspect_ratio",     "ca_star_low", "ca_star_high", "ca_h",
+               "ca_star_low_err", "ca_star_high_err", "ca_h_err",    "mesh_level",   "error_levels",
+               "ca_star_low_err_source", "ca_star_high_err_source", "ca_h_err_source", "bending_modulus", "level_answers",
+               "ca_star_low_err_lacks", "ca_star_high_err_lacks", "ca_h_err_lacks",
+               // added for the scripts that render Table 1 (scripts/table1, scripts/plot):
+               "campaign", "skalak_C", "role", "n_samples", "ca_star_below", "ca_star_above", "ca_min_d12", "ca_h_low",
+               "ca_h_high", "method", "note", "error_note", "group_key"};
+  t.json_columns = {"level_answers", "group_key"};  // {"ca_h": {"2": 0.23, "4": 0.61}, ...}: nested in JSON output
+  auto text_or_null = [](const std::string& x) { return x.empty() ? SqlValue{nullptr} : SqlValue{x}; };
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& r = rows[i];
+    t.rows.push_back({r.law, r.aspect_ratio, value_of(r.ca_star_low), value_of(r.ca_star_high), value_of(r.ca_h),
+                      value_of(r.ca_star_low_err), value_of(r.ca_star_high_err), value_of(r.ca_h_err),
+                      std::int64_t{r.mesh_level}, text_or_null(r.error_levels), text_or_null(r.ca_star_low_err_source),
+                      text_or_null(r.ca_star_high_err_source), text_or_null(r.ca_h_err_source),
+                      bending_modulus_of(r.group_key), text_or_null(campaign::level_answers_json(r.level_answers)),
+                      text_or_null(r.ca_star_low_err_lacks), text_or_null(r.ca_star_high_err_lacks),
+                      text_or_null(r.ca_h_err_lacks), campaign_of[i],
+                      r.skalak_C < 0 ? SqlValue{nullptr} : SqlValue{r.skalak_C}, r.role, std::int64_t{r.n_samples},
+                      value_of(r.ca_star_below), value_of(r.ca_star_above), value_of(r.ca_min_d12),
+                      value_of(r.ca_h_low), value_of(r.ca_h_high), r.method, text_or_null(r.note),
+                      text_or_null(r.error_note), text_or_null(r.group_key)});
+  }
+  return t;
 }
 
 int table1(campaign::Store& store, const std::string& name, campaign::Format fmt, int mesh_level, double skalak_C,
@@ -96,22 +128,7 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
   if (rows.empty())
     throw BadInput("campaign '" + camp + "' has no transitions yet (run it first: capsim campaign run ...)");
   if (fmt != campaign::Format::kMarkdown) {
-    campaign::Table t;
-    t.columns = {"law",          "aspect_ratio",     "ca_star_low", "ca_star_high", "ca_h",
-                 "ca_star_low_err", "ca_star_high_err", "ca_h_err",    "mesh_level",   "error_levels",
-                 "ca_star_low_err_source", "ca_star_high_err_source", "ca_h_err_source", "bending_modulus", "level_answers",
-                 "ca_star_low_err_lacks", "ca_star_high_err_lacks", "ca_h_err_lacks"};
-    t.json_columns = {"level_answers"};  // {"ca_h": {"2": 0.23, "4": 0.61}, ...}: nested in JSON output
-    auto text_or_null = [](const std::string& x) { return x.empty() ? SqlValue{nullptr} : SqlValue{x}; };
-    for (const auto& r : rows)
-      t.rows.push_back({r.law, r.aspect_ratio, value_of(r.ca_star_low), value_of(r.ca_star_high), value_of(r.ca_h),
-                        value_of(r.ca_star_low_err), value_of(r.ca_star_high_err), value_of(r.ca_h_err),
-                        std::int64_t{r.mesh_level}, text_or_null(r.error_levels), text_or_null(r.ca_star_low_err_source),
-                        text_or_null(r.ca_star_high_err_source), text_or_null(r.ca_h_err_source),
-                        bending_modulus_of(r.group_key), text_or_null(campaign::level_answers_json(r.level_answers)),
-                        text_or_null(r.ca_star_low_err_lacks), text_or_null(r.ca_star_high_err_lacks),
-                        text_or_null(r.ca_h_err_lacks)});
-    std::printf("%s", campaign::render(t, fmt).c_str());
+    std::printf("%s", campaign::render(transitions_table(rows, std::vector<std::string>(rows.size(), camp)), fmt).c_str());
     return 0;
   }
   // Markdown laid out like the seed's Table 1: one column per a/b, a Ca* line and a CaH line per law. With an
@@ -206,7 +223,33 @@ int cases(campaign::Store& store, const std::string& name, campaign::Format fmt,
   f.ca_max = ca_max;
   f.status = status;
   auto t = store.cases_table(f);
+  if (fmt != campaign::Format::kJson) {
+    // The case folder and the stored result line serve scripts (JSON); the tables for reading keep their width.
+    for (const char* wide : {"summary", "out_dir"}) {
+      const auto c = std::find(t.columns.begin(), t.columns.end(), wide) - t.columns.begin();
+      t.columns.erase(t.columns.begin() + c);
+      for (auto& row : t.rows) row.erase(row.begin() + c);
+    }
+  }
   std::printf("%s", campaign::render(t, fmt).c_str());
+  return 0;
+}
+
+// `query transitions`: every stored transition group of a campaign (or of every campaign), all levels and roles.
+int transitions(campaign::Store& store, const std::string& name, campaign::Format fmt, const std::string& role) {
+  if (!role.empty() && role != "answer" && role != "scan" && role != "mesh_check" && role != "dt_check")
+    throw BadInput("--role: expected answer, scan, mesh_check or dt_check, got '" + role + "'");
+  const auto camps = store.campaigns(name);
+  if (!name.empty() && camps.empty()) throw BadInput(store.db().path() + ": no campaign named '" + name + "'");
+  std::vector<campaign::Transition> rows;
+  std::vector<std::string> campaign_of;
+  for (const auto& c : camps)
+    for (auto& r : store.transitions(c.campaign_id))
+      if (role.empty() || r.role == role) {
+        rows.push_back(std::move(r));
+        campaign_of.push_back(c.name);
+      }
+  std::printf("%s", campaign::render(transitions_table(rows, campaign_of), fmt).c_str());
   return 0;
 }
 
@@ -245,19 +288,18 @@ int query_command(const std::vector<std::string>& args) {
   cs->add_option("--ca-min", ca_min, "smallest capillary number");
   cs->add_option("--ca-max", ca_max, "largest capillary number");
   cs->add_option("--status", status, "queued, running, done, unstable or failed");
+  auto* tr = app.add_subcommand("transitions", "every stored transition group (all mesh levels and roles) with its "
+                                               "errors and provenance");
+  common(tr);
+  std::string role;
+  tr->add_option("--campaign", camp, "only this campaign (default: every campaign)");
+  tr->add_option("--role", role, "only this role: answer, scan, mesh_check or dt_check");
   auto* sq = app.add_subcommand("sql", "run read-only SQL (writes are refused)");
   common(sq);
   std::string text;
   sq->add_option("statement", text, "SQL text, e.g. \"SELECT * FROM transitions\"")->required();
 
-  std::vector<std::string> rev(args.rbegin(), args.rend());
-  try {
-    app.parse(rev);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::fprintf(stderr, "capsim query: %s (see capsim query --help)\n", e.what());
-    return kExitBadInput;
-  }
+  if (const auto code = parse_args(app, args)) return *code;
   try {
     const auto fmt = campaign::parse_format(format);
     auto store = campaign::Store::open_readonly(db);
@@ -265,6 +307,7 @@ int query_command(const std::vector<std::string>& args) {
       return table1(*store, camp, fmt, mesh_level, skalak_C,
                     bending >= 0 ? std::optional<double>(bending) : std::nullopt);
     if (*cs) return cases(*store, camp, fmt, law, ar, ca_min, ca_max, status);
+    if (*tr) return transitions(*store, camp, fmt, role);
     return sql(*store, text, fmt);
   } catch (const BadInput& e) {
     std::fprintf(stderr, "capsim query: error: %s\n", campaign::one_line(e.what()).c_str());

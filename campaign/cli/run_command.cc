@@ -5,11 +5,10 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
-#include <iostream>
 
-#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "campaign/cli/cli_app.h"
 #include "campaign/cli/commands.h"
 #include "capsim/version.h"
 #include "solver/config/case_config.h"
@@ -33,9 +32,9 @@ int run_command(const std::vector<std::string>& args) {
   int threads = 0;
   bool resume = false, json = false, quiet = false;
   app.add_option("case", case_file, "case file (TOML); '-' or an empty file = all defaults")->required();
-  app.add_option("--set", overrides, "override one key: section.key=value (repeatable)");
+  add_set_option(app, overrides);
   app.add_option("--out", out_dir, "output directory (case.h5, case.xmf, checkpoint.h5)");
-  app.add_option("--threads", threads, "OpenMP threads (default: all cores)")->check(CLI::Range(0, 4096));
+  add_threads_option(app, threads);
   app.add_flag("--resume", resume, "continue from OUT/checkpoint.h5 if present");
   app.add_flag("--json", json, "print a JSON summary as the last stdout line");
   app.add_flag("--quiet", quiet, "no configuration echo or progress on stderr");
@@ -43,17 +42,7 @@ int run_command(const std::vector<std::string>& args) {
   app.add_option("--stop-after", stop_after,
                  "checkpoint and stop (exit 3) after this many steps of this invocation, as if interrupted")
       ->check(CLI::NonNegativeNumber);
-  std::vector<std::string> rev(args.rbegin(), args.rend());
-  try {
-    app.parse(rev);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) {
-      std::cout << app.help();
-      return 0;
-    }
-    std::fprintf(stderr, "capsim run: %s\n", e.what());
-    return kExitBadInput;
-  }
+  if (const auto code = parse_args(app, args)) return *code;
 
   config::CaseConfig config;
   try {
@@ -123,8 +112,13 @@ int run_command(const std::vector<std::string>& args) {
 }
 
 int summary_command(const std::vector<std::string>& args) {
+  CLI::App app{"The case summary of `capsim run --json` with the given fields (for stand-in test workers)",
+               "capsim _summary"};
+  std::vector<std::string> items;
+  app.add_option("fields", items, "key=value (a value that parses as a JSON number, true/false or null is one)");
+  if (const auto code = parse_args(app, args)) return *code;
   nlohmann::json fields = nlohmann::json::object();
-  for (const auto& arg : args) {
+  for (const auto& arg : items) {
     const auto eq = arg.find('=');
     if (eq == std::string::npos || eq == 0) {
       std::fprintf(stderr, "capsim _summary: expected key=value, got '%s'\n", arg.c_str());

@@ -736,7 +736,7 @@ Table Store::cases_table(const CaseFilter& f) {
          "json_extract(r.raw_json, '$.flow_evaluations') AS flow_evaluations, "
          "CASE WHEN r.case_id IS NULL THEN NULL ELSE " CAPSIM_CASE_THREADS " END AS threads, "
          CAPSIM_CASE_CORE_S " AS core_s, "
-         "c.code_version, c.error, c.h5_path, c.params_json AS params "
+         "c.code_version, c.error, c.h5_path, c.params_json AS params, c.out_dir, r.raw_json AS summary "
          "FROM cases c LEFT JOIN results r ON r.case_id=c.case_id "
          "WHERE (?1 = '' OR c.case_id IN (SELECT cc.case_id FROM campaign_cases cc JOIN campaigns k "
          "ON k.campaign_id=cc.campaign_id WHERE k.name=?1)) "
@@ -744,7 +744,9 @@ Table Store::cases_table(const CaseFilter& f) {
          "AND c.capillary_number >= ?4 AND c.capillary_number <= ?5 AND (?6 = '' OR c.status = ?6) "
          "ORDER BY c.law, c.aspect_ratio, c.skalak_C, c.mesh_level, c.capillary_number");
   s.bind(1, f.campaign).bind(2, f.law).bind(3, f.aspect_ratio).bind(4, f.ca_min).bind(5, f.ca_max).bind(6, f.status);
-  return read_table(s);
+  Table t = read_table(s);
+  t.json_columns = {"summary"};
+  return t;
 }
 
 int Store::count_campaign_cases(std::int64_t campaign_id, const std::string& origin) {

@@ -188,7 +188,8 @@ class Store {
   std::vector<ProblemCase> problem_cases(std::int64_t campaign_id, int limit);
   /// @brief Cases with their results (`capsim query cases`): identity columns, status, the result summary,
   /// wall_s, flow_evaluations, threads and core_s (worker wall × threads: the cost campaign status and the
-  /// level costs sum), code_version, error, h5_path and params (every case key, JSON text).
+  /// level costs sum), code_version, error, h5_path, params (every case key, JSON text), out_dir (the case
+  /// folder) and summary (the worker's JSON result line as stored, a JSON column; null before a result).
   Table cases_table(const CaseFilter& filter);
   /// @brief Number of cases linked to a campaign with origin @p origin ("grid" | "adaptive").
   int count_campaign_cases(std::int64_t campaign_id, const std::string& origin);

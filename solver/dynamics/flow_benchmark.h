@@ -25,17 +25,19 @@ namespace capsim::dynamics {
 
 /// @brief What to measure.
 struct FlowBenchOptions {
-  int level = 3;   ///< mesh.level of the scene
+  /// @brief The measured capsule as a case: by default the a/b = 2 Skalak capsule at Ca = 0.3 on mesh level 3
+  /// in double precision; any case key may change it (scene_with). With numerics.kernel_precision "mixed" the
+  /// same scene is also evaluated in double, alternately in the same run (FlowBenchScene::evaluation_double_ms):
+  /// the speed-up.
+  config::CaseConfig scene = scene_with({});
   int repeat = 0;  ///< timed evaluations per scene; 0 = automatic (about a second per scene, 5..400)
-  double bending_modulus = 0.0;  ///< capsule.bending_modulus of the scene (0: the seed's membrane)
-  /// numerics.kernel_precision of the evaluation: "double" or "mixed". With "mixed" the same scene is also
-  /// evaluated in double, alternately in the same run (FlowBenchScene::evaluation_double_ms): the speed-up.
-  std::string kernel_precision = "double";
   /// @brief Whether the options are usable; if not and why is not null, *why says which and why (the case
   /// keys' ranges are the key registry's: the message names the key).
   [[nodiscard]] bool valid(std::string* why = nullptr) const;
-  /// @brief The measured scene as a case: the a/b = 2 Skalak capsule at Ca = 0.3 with these options' keys.
-  [[nodiscard]] config::CaseConfig scene_case() const;
+  /// @brief The default scene with `section.key=value` overrides, read and checked as `capsim run --set` reads
+  /// them (config::parse_case_config; a later override of a key replaces an earlier one).
+  /// @throws config::ConfigError naming the key of a bad override.
+  [[nodiscard]] static config::CaseConfig scene_with(const std::vector<std::string>& overrides);
 };
 
 /// @brief One scene's measurement. Times are milliseconds per evaluation.

@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
     for (int k = 0; k < 2; ++k) {
       omp_set_num_threads(k + 1);
       FlowBenchOptions o;
-      o.level = level;
+      o.scene.level = level;
       o.repeat = repeat;
       reports[k].push_back(capsim::dynamics::bench_flow(o));
       const auto& s = reports[k].back().scenes;

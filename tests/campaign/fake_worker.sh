@@ -11,15 +11,18 @@
 #   FAKE_LEVEL_SHIFT=s: CaH of mesh level L is CaH - s 2^-L (first order in h, limit CaH);
 #   FAKE_DT_COEF=c: max_tau_min - c dt² (second order in dt; dt = time.dt of the case file, else 0.01,
 #   which is also the dt reported).
-# The JSON line is printed by `capsim _summary` (the case summary of the real worker): the capsim binary is
-# $FAKE_CAPSIM, else the capsim that started this worker (campaign run), else the one next to the test
-# executable that did (build/tests/X -> build/bin/capsim), else the source tree's build/bin/capsim, else
-# capsim on PATH.
+# The JSON line is printed by `capsim _summary` (the case summary of the real worker) of the capsim binary
+# $FAKE_CAPSIM, which the caller must hand over (tests/campaign/test_util.h fake_worker_env): the worker is
+# not searched for, since under Slurm it is started by slurmd and wherever the build is its path is not known.
 # Faults, chosen by Ca (comma-separated lists, exact text as written in the case file):
 #   FAKE_CRASH_CA: SIGSEGV itself; FAKE_FAIL_CA: exit 1 with a message; FAKE_UNSTABLE_CA: status unstable;
 #   FAKE_BADINPUT_CA: exit 2. FAKE_LOG: append "done <DIR>" when a case completes.
 # Slow cases: FAKE_SLOW_CA (list) on mesh level FAKE_SLOW_LEVEL (any if unset) take FAKE_SLOW_STEP_S (1 s) per step.
 set -u
+# A stop request from the start on, so that one sent while the worker is still reading its case (a loaded
+# machine takes a second for that) is a checkpoint and exit 3 as well, not death by the signal.
+stop=0
+trap 'stop=1' TERM INT
 [ "${1:-}" = "run" ] || { echo "fake_worker: expected 'run'" >&2; exit 2; }
 shift
 case_file="$1"; shift
@@ -34,25 +37,9 @@ while [ $# -gt 0 ]; do
   esac
 done
 [ -f "$case_file" ] || { echo "fake_worker: $case_file: no such file" >&2; exit 2; }
-find_capsim() {
-  [ -n "${FAKE_CAPSIM:-}" ] && { echo "$FAKE_CAPSIM"; return; }
-  local pid=$PPID exe
-  while [ -n "$pid" ] && [ "$pid" -gt 1 ]; do
-    exe=$(readlink "/proc/$pid/exe" 2>/dev/null)
-    case "$exe" in
-      */capsim) echo "$exe"; return ;;
-      */tests/*) for c in "${exe%/tests/*}/bin/capsim" "${exe%/tests/*}/capsim"; do
-                   [ -x "$c" ] && { echo "$c"; return; }
-                 done ;;
-    esac
-    pid=$(awk '{ print $4 }' "/proc/$pid/stat" 2>/dev/null)
-  done
-  local here; here=$(cd "$(dirname "$0")" && pwd)
-  [ -x "$here/../../build/bin/capsim" ] && { echo "$here/../../build/bin/capsim"; return; }
-  command -v capsim
-}
-capsim_bin=$(find_capsim)
-[ -x "$capsim_bin" ] || { echo "fake_worker: no capsim binary found (set FAKE_CAPSIM)" >&2; exit 1; }
+capsim_bin=${FAKE_CAPSIM:-}
+[ -n "$capsim_bin" ] || { echo "fake_worker: FAKE_CAPSIM is not set (the capsim binary that prints the result)" >&2; exit 2; }
+[ -x "$capsim_bin" ] || { echo "fake_worker: FAKE_CAPSIM=$capsim_bin is not an executable" >&2; exit 2; }
 mkdir -p "$out"
 get() { awk -F' = ' -v k="$1" '$1 == k { gsub(/"/, "", $2); print $2; exit }' "$case_file"; }
 ca=$(get capillary_number); ar=$(get aspect_ratio); law=$(get law); level=$(get level); C=$(get skalak_C)
@@ -70,8 +57,6 @@ if [ $resume = 1 ]; then
   echo "fake_worker: resuming at step $step" >&2
 fi
 checkpoint() { echo "$step" > "$out/checkpoint.tmp" && mv "$out/checkpoint.tmp" "$out/checkpoint.txt"; }
-stop=0
-trap 'stop=1' TERM INT
 
 in_list "$ca" "${FAKE_BADINPUT_CA:-}" && { echo "fake_worker: flow.capillary_number: rejected" >&2; exit 2; }
 while [ "$step" -lt "$steps" ]; do

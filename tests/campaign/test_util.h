@@ -29,6 +29,10 @@ inline std::string exe() {
   return e && *e ? e : CAPSIM_EXE_PATH;
 }
 inline std::string fake_worker() { return std::string(CAPSIM_SOURCE_DIR) + "/tests/campaign/fake_worker.sh"; }
+/// The environment that makes the fake worker the campaign's worker (CAPSIM_WORKER) and hands it the capsim
+/// binary under test (FAKE_CAPSIM, whose `_summary` prints its result line): explicitly, because the worker
+/// may be started by slurmd, whose process tree holds no capsim, from a build folder anywhere.
+inline std::string fake_worker_env() { return "FAKE_CAPSIM=" + exe() + " CAPSIM_WORKER=" + fake_worker(); }
 
 /// A fresh folder per test under CAPSIM_TEST_TMP.
 inline std::string fresh_dir(const std::string& name) {
@@ -147,7 +151,7 @@ inline std::string prolate_campaign(const std::string& name, const std::string& 
 /// A campaign command with the fake worker and extra environment.
 inline std::string campaign_cmd(const std::string& env, const std::string& file, const std::string& db,
                                 const std::string& extra = "") {
-  return "env " + env + " CAPSIM_WORKER=" + fake_worker() + " " + exe() + " campaign run " + file + " --db " + db + " " + extra;
+  return "env " + env + " " + fake_worker_env() + " " + exe() + " campaign run " + file + " --db " + db + " " + extra;
 }
 
 /// Number of non-empty lines.

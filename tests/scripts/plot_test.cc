@@ -54,8 +54,11 @@ std::string q(const fs::path& p) {
   s += '\'';
   return s;
 }
-std::string plot() { return kPython + " " + q(fs::path(kSrc) / "scripts" / "plot"); }
-std::string table1() { return kPython + " " + q(fs::path(kSrc) / "scripts" / "table1"); }
+// The scripts read databases through `capsim query`: they are handed the capsim under test, wherever it was built.
+std::string plot() { return kPython + " " + q(fs::path(kSrc) / "scripts" / "plot") + " --capsim " + q(CAPSIM_EXE_PATH); }
+std::string table1() {
+  return kPython + " " + q(fs::path(kSrc) / "scripts" / "table1") + " --capsim " + q(CAPSIM_EXE_PATH);
+}
 std::string mesh_check() { return kPython + " " + q(fs::path(kSrc) / "scripts" / "mesh_check"); }
 std::string compare_campaigns() { return kPython + " " + q(fs::path(kSrc) / "scripts" / "compare_campaigns"); }
 

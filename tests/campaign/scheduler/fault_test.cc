@@ -211,7 +211,7 @@ aspect_ratio = [0.5]
   const std::string out = fs::weakly_canonical(db + ".runs/" + id).string();
   kill(mgr, SIGKILL);
   wait_child(mgr, 10);
-  pid_t orphan = spawn_sh("env FAKE_STEPS=400 FAKE_STEP_S=0.05 " + fake_worker() + " run " + out + "/case.toml --out " +
+  pid_t orphan = spawn_sh("env " + fake_worker_env() + " FAKE_STEPS=400 FAKE_STEP_S=0.05 " + fake_worker() + " run " + out + "/case.toml --out " +
                           out + " --threads 1 --json");
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   ASSERT_FALSE(find_orphan_workers(db + ".runs").empty());

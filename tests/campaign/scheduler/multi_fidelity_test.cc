@@ -126,7 +126,8 @@ TEST(MultiFidelity, ErrorCheckPlacesTheFinerLevelAgainstTheTwoLevelErrorBar) {
   ASSERT_TRUE(two[0]["level_answers"].is_object()) << q.out;
   EXPECT_NEAR(two[0]["level_answers"]["ca_h"]["1"].get<double>(),
               two[0]["ca_h"].get<double>() - two[0]["ca_h_err"].get<double>(), 1e-12) << q.out;
-  const std::string table1 = "/usr/bin/python3 " + std::string(CAPSIM_SOURCE_DIR) + "/scripts/table1";
+  const std::string table1 =
+      "/usr/bin/python3 " + std::string(CAPSIM_SOURCE_DIR) + "/scripts/table1 --capsim " + exe();
   auto r = sh(table1 + " --db " + dir + "/three.db --error-check " + dir + "/two.json");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("| CaH | 0.5 ± 0.2 (1,2) | 0.60 | 0.50 errors | within |"), std::string::npos) << r.out;

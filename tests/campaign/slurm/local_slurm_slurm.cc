@@ -129,7 +129,7 @@ law = ["neo-hookean", "skalak"]
 capillary_number = [0.02, 0.2]
 )");
   const std::string db = dir + "/slurm.db", ref = dir + "/local.db";
-  const std::string env = "env CAPSIM_WORKER=" + fake_worker() + " FAKE_STEPS=100 ";
+  const std::string env = "env " + fake_worker_env() + " FAKE_STEPS=100 ";
   auto r = sh(env + "FAKE_STEP_S=0.1 " + exe() + " campaign submit " + dir + "/c.toml --db " + db +
               " --cases-per-task 4");
   ASSERT_EQ(r.code, 0) << r.err;

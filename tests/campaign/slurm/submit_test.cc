@@ -41,7 +41,7 @@ struct FakeSlurm {
   }
   /// Environment prefix: the stand-ins first in PATH, the fake worker.
   std::string env(const std::string& extra = "") const {
-    return "env PATH=" + dir + ":/usr/bin:/bin CAPSIM_WORKER=" + fake_worker() + " " + extra + " ";
+    return "env PATH=" + dir + ":/usr/bin:/bin " + fake_worker_env() + " " + extra + " ";
   }
   void live(const std::string& lines) const { write_file(dir + "/squeue.txt", lines); }
   std::string script(int job) const { return dir + "/submitted-" + std::to_string(job) + ".sh"; }
@@ -286,7 +286,7 @@ TEST(SlurmSubmit, BadInputChangesNothing) {
   // sbatch missing: one clear message, exit 2, no database created.
   // (PATH is an empty folder, so a Slurm installed on this machine stays hidden.)
   fs::create_directories(dir + "/empty");
-  auto r = sh("env PATH=" + dir + "/empty CAPSIM_WORKER=" + fake_worker() + " " + exe() + " campaign submit " + dir +
+  auto r = sh("env PATH=" + dir + "/empty " + fake_worker_env() + " " + exe() + " campaign submit " + dir +
               "/c.toml --db " + db);
   EXPECT_EQ(r.code, 2) << r.out << r.err;
   EXPECT_NE(r.err.find("sbatch not found"), std::string::npos) << r.err;

@@ -56,7 +56,7 @@ void duffy_mixed(const ApexTableF& tb, const double C[6][3], const double D[6][3
     float fx = 0.0f, fy = 0.0f, fz = 0.0f;
     // The body of the double loop in SingleLayer::singular_correction, in float and about the apex. Written
     // out twice on purpose: one shared inline template for both made GCC 12 slower here (float singular phase
-    // 0.78–0.92 → 1.14–1.16 ms on a level-3 evaluation, alternated runs, 2026-12-06), as a shared geometry
+    // 0.78–0.92 → 1.14–1.16 ms on a level-3 evaluation, alternated runs), as a shared geometry
     // helper had before (results/benchmarks.md, "Flow evaluation by phase").
 #pragma omp simd reduction(+ : fx, fy, fz)
     for (int p = p0; p < p1; ++p) {

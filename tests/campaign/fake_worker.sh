@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # A stand-in for `capsim run CASE.toml --out DIR --threads N [--resume] --json` that follows the worker
-# contract (campaign/README.md, "The worker contract", issue 4) without the physics, for the campaign manager's fault tests.
+# contract (campaign/README.md, "The worker contract") without the physics, for the campaign manager's fault tests.
 # It "computes" in FAKE_STEPS steps of FAKE_STEP_S seconds, checkpoints to DIR/checkpoint.txt each step,
 # exits 3 after checkpointing on SIGTERM/SIGINT, continues from the checkpoint with --resume, and prints
 # a JSON result whose min_D12 / max_tau_min are simple functions of Ca with known Ca* and CaH:

@@ -105,7 +105,7 @@ TEST(MultiFidelity, ScanAnswerCheckAndTheErrorBarOfCaH) {
   EXPECT_EQ(sh(exe() + " query sql \"SELECT count(*) AS n FROM cases\" --db " + db + " --format json").out, before);
 }
 
-// The honesty check of issue 14 §4 (scripts/table1 --error-check): the answer of a two-level campaign
+// The honesty check (scripts/table1 --error-check): the answer of a two-level campaign
 // (levels 1–2) with its error, against the value a third level gives (levels 1–2–3). Fake CaH of level L:
 // 0.699 − 0.8 · 2^-L, so level 2 says 0.499 ± 0.2 (the level 1 → 2 difference) and level 3 gives 0.599: within,
 // half an error off. With the answer shifted by more than its error the check must say so.

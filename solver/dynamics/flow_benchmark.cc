@@ -134,7 +134,7 @@ FlowBenchScene measure_scene(CapsuleFlow& flow, CapsuleFlow* in_double, const Ei
 config::CaseConfig FlowBenchOptions::scene_case() const {
   config::CaseConfig c;
   c.aspect_ratio = 2.0;
-  c.law = "skalak";
+  c.law = config::MembraneLawKind::Skalak;
   c.capillary_number = 0.3;
   c.level = level;
   c.bending_modulus = bending_modulus;

@@ -20,7 +20,7 @@ config::CaseConfig sphere_case(int level, double Ca) {
   c.aspect_ratio = 1.0;
   c.level = level;
   c.capillary_number = Ca;
-  c.law = "neo-hookean";
+  c.law = config::MembraneLawKind::NeoHookean;
   return c;
 }
 

@@ -123,7 +123,7 @@ int bench_flow(const BenchArgs& ba) {
   }
   std::printf("Flow evaluation, level %d (%d nodes), a/b = %g %s Ca = %g deformed, bending modulus %g, %d "
               "thread(s), kernel %s\n",
-              r.level, r.scenes.front().nodes, scene.aspect_ratio, scene.law.c_str(), scene.capillary_number,
+              r.level, r.scenes.front().nodes, scene.aspect_ratio, std::string(config::word_of(scene.law)).c_str(), scene.capillary_number,
               scene.bending_modulus, r.threads, r.isa.c_str());
   std::printf("%-10s %7s %9s %9s %8s | %8s %8s %8s %8s %8s %8s %8s %8s %8s %8s\n", "scene", "targets", "eval ms",
               "bare ms", "ratio", "membrane", "bending", "load", "layout", "regular", "far", "singular", "near",

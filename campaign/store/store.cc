@@ -88,7 +88,8 @@ std::string result_mismatch(const nlohmann::json& j, const CaseParams& p) {
   } catch (const std::invalid_argument& e) {
     return e.what();
   }
-  return driver::parameter_mismatch(s.parameters, {p.capillary_number(), p.aspect_ratio(), p.law(), p.skalak_C(),
+  const config::MembraneLawKind law = config::from_word<config::MembraneLawKind>(p.law()).value();
+  return driver::parameter_mismatch(s.parameters, {p.capillary_number(), p.aspect_ratio(), law, p.skalak_C(),
                                                    p.mesh_level(), p.bending_modulus()});
 }
 

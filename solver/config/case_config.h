@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "solver/config/case_enums.h"
+
 namespace capsim::config {
 
 /// @brief Bad input in a case file or override: the message names the key or the file.

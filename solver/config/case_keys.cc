@@ -5,6 +5,7 @@
 #include <cmath>
 #include <initializer_list>
 #include <sstream>
+#include <type_traits>
 
 #include "solver/config/case_config.h"
 
@@ -34,6 +35,12 @@ KeyRule one_of(std::initializer_list<std::string_view> words) {
   return r;
 }
 KeyRule one_of_bool() { return {}; }
+template <class E>
+KeyRule its_words() {
+  KeyRule r;
+  for (const auto& [value, word] : KeyWords<E>::words) r.words.emplace_back(word);
+  return r;
+}
 KeyRule auto_or(KeyRule numbers) {
   numbers.words = {"auto"};
   return numbers;
@@ -84,6 +91,14 @@ struct Field<std::string> {
   static constexpr KeyType type = KeyType::kString;
   static KeyValue to_value(const std::string& x) { return x; }
   static std::string from_value(const KeyValue& v) { return std::get<std::string>(v); }
+};
+// An enum key: its word outside CaseConfig, parsed once here (check_case_value has accepted the word).
+template <class E>
+  requires std::is_enum_v<E>
+struct Field<E> {
+  static constexpr KeyType type = KeyType::kString;
+  static KeyValue to_value(E x) { return std::string(word_of(x)); }
+  static E from_value(const KeyValue& v) { return from_word<E>(std::get<std::string>(v)).value(); }
 };
 template <>
 struct Field<std::optional<double>> {

@@ -33,7 +33,7 @@ std::vector<io::Attribute> case_attributes(const config::CaseConfig& c) {
   std::vector<io::Attribute> a;
   a.emplace_back("capillary_number", c.capillary_number);
   a.emplace_back("aspect_ratio", c.aspect_ratio);
-  a.emplace_back("law", c.law);
+  a.emplace_back("law", std::string(config::word_of(c.law)));
   a.emplace_back("skalak_C", c.skalak_C);
   a.emplace_back("mesh_level", c.level);
   a.emplace_back("bending_modulus", c.bending_modulus);

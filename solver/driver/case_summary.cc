@@ -112,8 +112,8 @@ std::string parameter_mismatch(const CaseParameters& reported, const CaseParamet
   if (!near(reported.capillary_number, expected.capillary_number))
     return "capillary_number " + text(reported.capillary_number);
   if (!near(reported.aspect_ratio, expected.aspect_ratio)) return "aspect_ratio " + text(reported.aspect_ratio);
-  if (reported.law != expected.law) return "law \"" + reported.law + "\"";
-  if (expected.law == "skalak" && !near(reported.skalak_C, expected.skalak_C))
+  if (reported.law != expected.law) return "law \"" + std::string(config::word_of(reported.law)) + "\"";
+  if (expected.law == config::MembraneLawKind::Skalak && !near(reported.skalak_C, expected.skalak_C))
     return "skalak_C " + text(reported.skalak_C);
   if (reported.mesh_level != expected.mesh_level) return "mesh_level " + std::to_string(reported.mesh_level);
   if (!near(reported.bending_modulus, expected.bending_modulus))
@@ -155,7 +155,7 @@ nlohmann::json CaseSummary::to_json() const {
       {"capillary_number", parameters.capillary_number},
       {"Ca", parameters.capillary_number},  // the name campaign/README.md, "The worker contract" promises; capillary_number is the long one
       {"aspect_ratio", parameters.aspect_ratio},
-      {"law", parameters.law},
+      {"law", std::string(config::word_of(parameters.law))},
       {"skalak_C", parameters.skalak_C},
       {"mesh_level", parameters.mesh_level},
       {"bending_modulus", parameters.bending_modulus},
@@ -183,8 +183,9 @@ CaseSummary CaseSummary::from_json(const nlohmann::json& j) {
   s.reason = string_or_empty(j, "reason");
   s.parameters.capillary_number = required_number(j, "capillary_number");
   s.parameters.aspect_ratio = required_number(j, "aspect_ratio");
-  s.parameters.law = string_or_empty(j, "law");
-  if (s.parameters.law.empty()) throw std::invalid_argument("result: 'law' missing or not a string");
+  const auto law = config::from_word<config::MembraneLawKind>(string_or_empty(j, "law"));
+  if (!law) throw std::invalid_argument("result: 'law' missing or not a capsule.law word");
+  s.parameters.law = *law;
   s.parameters.skalak_C = required_number(j, "skalak_C");
   const auto level = j.find("mesh_level");
   if (level == j.end() || !level->is_number_integer())
@@ -215,7 +216,7 @@ std::vector<io::Attribute> summary_attributes(const CaseSummary& s) {
   a.emplace_back("reason", s.reason);
   a.emplace_back("capillary_number", s.parameters.capillary_number);
   a.emplace_back("aspect_ratio", s.parameters.aspect_ratio);
-  a.emplace_back("law", s.parameters.law);
+  a.emplace_back("law", std::string(config::word_of(s.parameters.law)));
   a.emplace_back("skalak_C", s.parameters.skalak_C);
   a.emplace_back("mesh_level", s.parameters.mesh_level);
   a.emplace_back("bending_modulus", s.parameters.bending_modulus);

@@ -28,7 +28,7 @@ struct CaseResult;
 struct CaseParameters {
   double capillary_number = 0;  ///< Ca = μ γ̇ a / Gs (JSON: both "capillary_number" and "Ca")
   double aspect_ratio = 1;
-  std::string law;
+  config::MembraneLawKind law = config::MembraneLawKind::Skalak;  ///< JSON and attributes: its word
   double skalak_C = 0;  ///< enters the case only for the Skalak law
   int mesh_level = 0;
   double bending_modulus = 0;  ///< κ_b (JSON "bending_modulus"; a result from before the key reads as 0)

@@ -223,9 +223,9 @@ double automatic_time_step(const config::CaseConfig& config, const mesh::Surface
 
 double automatic_time_step(const config::CaseConfig& config, double h_min) {
   double stable = stable_time_step(h_min, config.capillary_number, config.dt_factor);
-  if (config.bending_modulus <= 0.0) return config.scheme == "rkc" ? std::max(config.dt_accuracy, stable) : stable;
+  if (config.bending_modulus <= 0.0) return config.scheme == config::TimeScheme::Rkc ? std::max(config.dt_accuracy, stable) : stable;
   stable /= 1.0 + bending_stiffness_ratio(config.bending_modulus, h_min);
-  if (config.scheme != "rkc") return stable;
+  if (config.scheme != config::TimeScheme::Rkc) return stable;
   // A stiff bending membrane on a fine mesh can need more stages than RKC allows at the accuracy step
   // (level 4, κ_b = 0.1: ≈ 600): cap dt so the reference state needs at most half of them, leaving room for
   // the prestress and the shrinking h_min of the deformed states.
@@ -237,7 +237,7 @@ double automatic_time_step(const config::CaseConfig& config, double h_min) {
 
 double evaluations_per_unit_time(const config::CaseConfig& config, double h_min) {
   const double dt = config.dt ? *config.dt : automatic_time_step(config, h_min);
-  if (config.scheme != "rkc") return 2.0 / dt;
+  if (config.scheme != config::TimeScheme::Rkc) return 2.0 / dt;
   return RkcIntegrator::stages_for(dt * reference_spectral_radius(config, h_min), RkcIntegrator::Options{}.damping) /
          dt;
 }

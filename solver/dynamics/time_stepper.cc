@@ -122,14 +122,16 @@ double max_element_distortion(const mesh::SurfaceMesh& mesh, const Eigen::Matrix
   return std::sqrt(worst);
 }
 
-std::unique_ptr<TimeIntegrator> make_integrator(const std::string& scheme, double rkc_safety) {
-  if (scheme == "rk2") return std::make_unique<Rk2Integrator>();
-  if (scheme == "rkc") {
-    RkcIntegrator::Options options;
-    options.safety = rkc_safety;
-    return std::make_unique<RkcIntegrator>(options);
+std::unique_ptr<TimeIntegrator> make_integrator(config::TimeScheme scheme, double rkc_safety) {
+  switch (scheme) {
+    case config::TimeScheme::Rk2: return std::make_unique<Rk2Integrator>();
+    case config::TimeScheme::Rkc: {
+      RkcIntegrator::Options options;
+      options.safety = rkc_safety;
+      return std::make_unique<RkcIntegrator>(options);
+    }
   }
-  throw std::invalid_argument("time.scheme = \"" + scheme + "\" is not known (choose \"rk2\" or \"rkc\")");
+  throw std::invalid_argument("make_integrator: not a time.scheme value");
 }
 
 double membrane_spectral_radius(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x, double capillary_number,

@@ -87,7 +87,7 @@ inline constexpr double kRkcSafety = 1.25;
 class Rk2Integrator final : public TimeIntegrator {
  public:
   StepInfo step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt, StartFields* start = nullptr) override;
-  [[nodiscard]] std::string name() const override { return "rk2"; }
+  [[nodiscard]] std::string name() const override { return std::string(config::word_of(config::TimeScheme::Rk2)); }
 
  private:
   Eigen::Matrix3Xd k1_, k2_, stage_;
@@ -121,7 +121,7 @@ class RkcIntegrator final : public TimeIntegrator {
   RkcIntegrator() : RkcIntegrator(Options{}) {}
   explicit RkcIntegrator(Options options) : options_(options) {}
   StepInfo step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt, StartFields* start = nullptr) override;
-  [[nodiscard]] std::string name() const override { return "rkc"; }
+  [[nodiscard]] std::string name() const override { return std::string(config::word_of(config::TimeScheme::Rkc)); }
 
   /// @brief β(s) = (1 + w0)/w1: the real stability interval [−β, 0] of the s-stage damped RKC.
   static double stability_boundary(int stages, double damping);
@@ -139,9 +139,8 @@ class RkcIntegrator final : public TimeIntegrator {
 /// @brief max |Δx_a − Δx_b| over the corner–mid-side node pairs of every element.
 double max_element_distortion(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& dx);
 
-/// @brief "rk2" | "rkc" → an integrator; @p rkc_safety is RkcIntegrator::Options::safety (time.rkc_safety).
-/// @throws std::invalid_argument naming the accepted values.
-std::unique_ptr<TimeIntegrator> make_integrator(const std::string& scheme, double rkc_safety = kRkcSafety);
+/// @brief The integrator of time.scheme; @p rkc_safety is RkcIntegrator::Options::safety (time.rkc_safety).
+std::unique_ptr<TimeIntegrator> make_integrator(config::TimeScheme scheme, double rkc_safety = kRkcSafety);
 
 /// @brief Upper estimate of the spectral radius of ∂v/∂x on positions x, from the membrane relaxation:
 ///   ρ ≈ kSpectralRadiusConstant · (1 + kPrestressCoefficient · max(τmax, 0)) / (Ca · h_min(x)),

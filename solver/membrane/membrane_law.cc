@@ -33,10 +33,12 @@ EnergyDerivatives SkalakLaw::derivatives(double I1, double Js) const {
   return {0.5 * (I1 + 1.0), Js * (C_ * I2 - 1.0)};
 }
 
-std::unique_ptr<MembraneLaw> make_law(const std::string& name, double skalak_C) {
-  if (name == "neo-hookean") return std::make_unique<NeoHookeanLaw>();
-  if (name == "skalak") return std::make_unique<SkalakLaw>(skalak_C);
-  throw std::invalid_argument("capsule.law = \"" + name + "\" is not known (choose \"neo-hookean\" or \"skalak\")");
+std::unique_ptr<MembraneLaw> make_law(config::MembraneLawKind law, double skalak_C) {
+  switch (law) {
+    case config::MembraneLawKind::NeoHookean: return std::make_unique<NeoHookeanLaw>();
+    case config::MembraneLawKind::Skalak: return std::make_unique<SkalakLaw>(skalak_C);
+  }
+  throw std::invalid_argument("make_law: not a capsule.law value");
 }
 
 }  // namespace capsim::membrane

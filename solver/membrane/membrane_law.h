@@ -9,6 +9,8 @@
 #include <memory>
 #include <string>
 
+#include "solver/config/case_enums.h"
+
 namespace capsim::membrane {
 
 /// @brief Partial derivatives of ws with respect to I1 (at fixed Js) and Js (at fixed I1).
@@ -38,7 +40,9 @@ class MembraneLaw {
 ///   τ1 = Gs/(λ1λ2) (λ1² − 1/(λ1λ2)²).  Ks = 3 Gs. Strain-softening under large stretch.
 class NeoHookeanLaw final : public MembraneLaw {
  public:
-  [[nodiscard]] std::string name() const override { return "neo-hookean"; }
+  [[nodiscard]] std::string name() const override {
+    return std::string(config::word_of(config::MembraneLawKind::NeoHookean));
+  }
   [[nodiscard]] double energy(double I1, double Js) const override;
   [[nodiscard]] EnergyDerivatives derivatives(double I1, double Js) const override;
   [[nodiscard]] double area_dilation_modulus() const override { return 3.0; }
@@ -51,7 +55,7 @@ class SkalakLaw final : public MembraneLaw {
  public:
   /// @throws std::invalid_argument unless C > −1/2 (finite).
   explicit SkalakLaw(double C);
-  [[nodiscard]] std::string name() const override { return "skalak"; }
+  [[nodiscard]] std::string name() const override { return std::string(config::word_of(config::MembraneLawKind::Skalak)); }
   [[nodiscard]] double energy(double I1, double Js) const override;
   [[nodiscard]] EnergyDerivatives derivatives(double I1, double Js) const override;
   [[nodiscard]] double area_dilation_modulus() const override { return 1.0 + 2.0 * C_; }
@@ -61,8 +65,8 @@ class SkalakLaw final : public MembraneLaw {
   double C_;
 };
 
-/// @brief The law named `name` ("neo-hookean" | "skalak"); skalak_C is used by Skalak only.
-/// @throws std::invalid_argument naming the accepted values.
-std::unique_ptr<MembraneLaw> make_law(const std::string& name, double skalak_C);
+/// @brief The law of capsule.law; skalak_C is used by Skalak only.
+/// @throws std::invalid_argument from SkalakLaw for C ≤ −1/2.
+std::unique_ptr<MembraneLaw> make_law(config::MembraneLawKind law, double skalak_C);
 
 }  // namespace capsim::membrane

@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
   const int repeat = argc > 2 ? std::atoi(argv[2]) : 20;
   config::CaseConfig c;
   c.aspect_ratio = 2.0;
-  c.law = "skalak";
+  c.law = config::MembraneLawKind::Skalak;
   c.capillary_number = 0.3;
   c.level = level;
   dynamics::CapsuleFlow flow(c);

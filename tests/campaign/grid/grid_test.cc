@@ -295,7 +295,7 @@ TEST(CaseKeys, CampaignDefaultsAreTheRegistrys) {
   EXPECT_EQ(p.capillary_number(), solver.capillary_number);
   EXPECT_EQ(p.aspect_ratio(), solver.aspect_ratio);
   EXPECT_EQ(p.skalak_C(), solver.skalak_C);
-  EXPECT_EQ(p.law(), solver.law);
+  EXPECT_EQ(p.law(), config::word_of(solver.law));
   EXPECT_EQ(p.mesh_level(), solver.level);
   EXPECT_EQ(p.t_end(), solver.t_end);
   for (const auto& k : case_keys()) EXPECT_EQ(p.values().count(k.name) == 1, k.always_stored) << k.name;

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "solver/config/case_config.h"
+#include "solver/dynamics/time_stepper.h"
 #include "solver/membrane/membrane_law.h"
 #include "solver/mesh/mesh.h"
 #include "solver/quadrature/triangle_rule.h"
@@ -45,7 +46,23 @@ TEST(CaseKeys, EveryNumberIsBoundedByAFiniteInterval) {
 
 TEST(CaseKeys, WordListsAreWhatTheSolverAccepts) {
   for (const auto& w : find_case_key("mesh.spheroid_map")->rule.words) EXPECT_NO_THROW((void)mesh::parse_spheroid_map(w)) << w;
-  for (const auto& w : find_case_key("capsule.law")->rule.words) EXPECT_NE(membrane::make_law(w, 1.0), nullptr) << w;
+  // The enum keys: every accepted word parses to a value whose word it is, and every value has its word accepted.
+  const auto law_words = find_case_key("capsule.law")->rule.words;
+  ASSERT_EQ(law_words.size(), KeyWords<MembraneLawKind>::words.size());
+  for (const auto& w : law_words) {
+    const auto law = from_word<MembraneLawKind>(w);
+    ASSERT_TRUE(law) << w;
+    EXPECT_EQ(word_of(*law), w);
+    EXPECT_EQ(membrane::make_law(*law, 1.0)->name(), w);
+  }
+  const auto scheme_words = find_case_key("time.scheme")->rule.words;
+  ASSERT_EQ(scheme_words.size(), KeyWords<TimeScheme>::words.size());
+  for (const auto& w : scheme_words) {
+    const auto scheme = from_word<TimeScheme>(w);
+    ASSERT_TRUE(scheme) << w;
+    EXPECT_EQ(dynamics::make_integrator(*scheme)->name(), w);
+  }
+  EXPECT_FALSE(from_word<MembraneLawKind>("mooney"));
   // Every accepted triangle-rule degree has a rule, and the rules the keys refuse (1 and 2) exist: the
   // registry's reason, not a missing rule, keeps them out.
   for (const char* key : {"numerics.regular_degree", "numerics.membrane_degree"}) {
@@ -81,7 +98,7 @@ TEST(CaseKeys, EchoReadsBackToTheSameCase) {
   CaseConfig c;
   c.level = 2;
   c.dt = 0.01;
-  c.law = "neo-hookean";
+  c.law = config::MembraneLawKind::NeoHookean;
   c.volume_correction = false;
   EXPECT_EQ(parse_case_config(c.to_toml(), "echo").to_map(), c.to_map());
   EXPECT_EQ(case_key_names().size(), case_keys().size());

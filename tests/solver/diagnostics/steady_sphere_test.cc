@@ -29,7 +29,7 @@ namespace fs = std::filesystem;
 TEST(SteadySphere, NeoHookeanAtCa03IsReportedSteadyWithThePublishedD12) {
   config::CaseConfig c;
   c.aspect_ratio = 1.0;
-  c.law = "neo-hookean";
+  c.law = config::MembraneLawKind::NeoHookean;
   c.capillary_number = 0.3;
   c.level = 2;
   c.t_end = 12.0;

@@ -49,7 +49,7 @@ TEST_P(LongRun, NoSilentNaNAndBlowUpsAreRecorded) {
   config::CaseConfig c;
   c.capillary_number = sc.Ca;
   c.aspect_ratio = sc.aspect_ratio;
-  c.law = sc.law;
+  c.law = config::from_word<config::MembraneLawKind>(sc.law).value();
   c.level = stress_level();
   c.t_end = 200.0;
   c.check_interval = 1000.0;  // never stop early on a converged period: the point is the long run

@@ -42,7 +42,7 @@ RunOptions quiet_in(const fs::path& dir) {
 TEST(CaseDriver, SphereMatchesSmallDeformationTheory) {
   config::CaseConfig c;
   c.aspect_ratio = 1.0;
-  c.law = "neo-hookean";
+  c.law = config::MembraneLawKind::NeoHookean;
   c.capillary_number = 0.01;
   c.level = 2;
   c.t_end = 1.0;
@@ -106,7 +106,7 @@ TEST(CaseDriver, BlowUpIsRecordedNotThrown) {
   c.aspect_ratio = 2.0;
   c.level = 1;
   c.capillary_number = 0.05;
-  c.scheme = "rk2";
+  c.scheme = config::TimeScheme::Rk2;
   c.dt = 0.5;  // far beyond the explicit stability limit ≈ 0.004 here
   c.t_end = 20.0;
   const auto dir = scratch("blowup");
@@ -127,7 +127,7 @@ config::CaseConfig growing_instability() {
   c.aspect_ratio = 2.0;
   c.level = 1;
   c.capillary_number = 0.05;
-  c.scheme = "rk2";
+  c.scheme = config::TimeScheme::Rk2;
   c.dt_factor = 0.6;  // 2.4 times the automatic rk2 dt; twice it already blows up (time_stepper_test)
   c.t_end = 20.0;
   c.checkpoint_interval = 0.0;
@@ -249,7 +249,7 @@ TEST(CaseDriver, RefusedRkcStepIsAnUnstableOutcome) {
   c.aspect_ratio = 2.0;
   c.capillary_number = 1e-4;
   c.level = 1;
-  c.scheme = "rkc";
+  c.scheme = config::TimeScheme::Rkc;
   // ρ ∝ 1/(Ca h_min) ≈ 4e5 at level 1 and Ca 1e-4, so the largest accepted dt (1) needs ≈ 900 stages, beyond
   // the 400 allowed (stages_for: β(s) ≈ 0.653 s² ≥ 1.25 dt ρ).
   c.dt = 1.0;
@@ -286,7 +286,7 @@ TEST(CaseDriver, OutputFolderThatCannotBeCreatedIsAnIoError) {
 TEST(CaseDriver, BendingRunIsStableRecordedAndResumesBitwise) {
   config::CaseConfig c;
   c.aspect_ratio = 0.5;
-  c.law = "neo-hookean";
+  c.law = config::MembraneLawKind::NeoHookean;
   c.capillary_number = 0.05;
   c.level = 1;
   c.t_end = 1.0;
@@ -368,7 +368,7 @@ void expect_option_keeps_the_case(const std::string& law, const std::function<vo
                                   const std::string& name, double bound) {
   config::CaseConfig c;
   c.aspect_ratio = 0.5;
-  c.law = law;
+  c.law = config::from_word<config::MembraneLawKind>(law).value();
   c.capillary_number = 0.05;
   c.level = 2;
   c.t_end = 0.6;

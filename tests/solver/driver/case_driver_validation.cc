@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 CaseResult run_figure2(double Ca, const std::string& law, const std::string& name) {
   config::CaseConfig c;
   c.aspect_ratio = 2.0;
-  c.law = law;
+  c.law = config::from_word<config::MembraneLawKind>(law).value();
   c.skalak_C = 1.0;
   c.capillary_number = Ca;
   c.level = 2;

@@ -18,7 +18,7 @@ CaseSummary example() {
   CaseSummary s;
   s.status = "unstable";
   s.reason = "volume changed by 5% at t = 3";
-  s.parameters = {0.3, 2.0, "skalak", 1.5, 2};
+  s.parameters = {0.3, 2.0, config::MembraneLawKind::Skalak, 1.5, 2};
   s.analysis.regime = diagnostics::Regime::swinging;
   s.analysis.min_D12 = 0.21;
   s.analysis.max_tau_min = -0.04;
@@ -96,7 +96,7 @@ TEST(CaseSummary, FromJsonRejectsAResultWithoutItsParameters) {
 
 // Defect 7: every parameter is compared, skalak_C too (only for the Skalak law, as the case identity).
 TEST(CaseSummary, ParameterMismatchComparesEveryParameter) {
-  const CaseParameters p{0.3, 2.0, "skalak", 1.0, 2};
+  const CaseParameters p{0.3, 2.0, config::MembraneLawKind::Skalak, 1.0, 2};
   EXPECT_EQ(parameter_mismatch(p, p), "");
   CaseParameters q = p;
   q.skalak_C = 2.0;
@@ -106,10 +106,10 @@ TEST(CaseSummary, ParameterMismatchComparesEveryParameter) {
   EXPECT_EQ(parameter_mismatch(q, p), "");
   q.mesh_level = 3;
   EXPECT_EQ(parameter_mismatch(q, p), "mesh_level 3");
-  CaseParameters nh{0.3, 2.0, "neo-hookean", 1.0, 2}, nh2 = nh;
+  CaseParameters nh{0.3, 2.0, config::MembraneLawKind::NeoHookean, 1.0, 2}, nh2 = nh;
   nh2.skalak_C = 7.0;
   EXPECT_EQ(parameter_mismatch(nh2, nh), "") << "skalak_C does not enter a neo-Hookean case";
-  nh2.law = "skalak";
+  nh2.law = config::MembraneLawKind::Skalak;
   EXPECT_NE(parameter_mismatch(nh2, nh), "");
 }
 

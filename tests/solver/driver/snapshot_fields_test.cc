@@ -36,7 +36,7 @@ TEST(NodalPrincipalTensions, UniformTensionsAreExactInEitherOrder) {
 // exactly uniform (the mesh maps the sphere with a small spread of element shapes).
 TEST(NodalPrincipalTensions, InflatedSphereIsUniformlyStretched) {
   const auto mesh = mesh::make_capsule_mesh(2, 1.0);
-  const auto law = membrane::make_law("neo-hookean", 1.0);
+  const auto law = membrane::make_law(config::MembraneLawKind::NeoHookean, 1.0);
   const membrane::MembraneMechanics mech(mesh, mesh.nodes, *law, membrane::MembraneMechanics::Options{6});
   const Eigen::Matrix3Xd x = 1.1 * mesh.nodes;
   const auto qp = mech.principal_tensions(x);

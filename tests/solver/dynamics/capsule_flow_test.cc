@@ -20,7 +20,16 @@ config::CaseConfig sphere_case(int level, double Ca) {
   c.aspect_ratio = 1.0;
   c.level = level;
   c.capillary_number = Ca;
-  c.law = "neo-hookean";
+  c.law = config::MembraneLawKind::NeoHookean;
+  return c;
+}
+
+// The prolate level-2 scene of most tests here: a/b = 2, Ca = 0.3 (forward Euler at dt = 0.01 is stable).
+config::CaseConfig prolate_case() {
+  config::CaseConfig c;
+  c.level = 2;
+  c.aspect_ratio = 2.0;
+  c.capillary_number = 0.3;
   return c;
 }
 
@@ -91,10 +100,7 @@ TEST(CapsuleFlow, FarFieldKeysReachTheBoundaryIntegral) {
 // symmetry step after step, so every evaluation stays the half-target one (without the on-plane fix of
 // SingleLayer::mirror it was lost after the first few steps).
 TEST(CapsuleFlow, MixedPrecisionKeepsTheSymmetricEvaluation) {
-  config::CaseConfig c;
-  c.level = 2;
-  c.aspect_ratio = 2.0;
-  c.capillary_number = 0.3;
+  config::CaseConfig c = prolate_case();
   CapsuleFlow dbl(c);
   c.kernel_precision = "mixed";
   CapsuleFlow mix(c);
@@ -118,10 +124,7 @@ TEST(CapsuleFlow, MixedPrecisionKeepsTheSymmetricEvaluation) {
 // to the kernel's accuracy (double: round-off; mixed: its 3e-7).
 TEST(CapsuleFlow, CentralSymmetryIsKeptStepAfterStep) {
   for (const std::string precision : {"double", "mixed"}) {
-    config::CaseConfig c;
-    c.level = 2;
-    c.aspect_ratio = 2.0;
-    c.capillary_number = 0.3;  // forward Euler at dt = 0.01 is stable here (MixedPrecisionKeepsTheSymmetricEvaluation)
+    config::CaseConfig c = prolate_case();
     c.kernel_precision = precision;
     CapsuleFlow mirror(c);
     c.central_symmetry = true;
@@ -171,10 +174,7 @@ TEST(CapsuleFlow, VelocityIsTheCompositionOfItsPublicPhases) {
   for (const Variant& variant : {Variant{"elastic", 0.0, false}, Variant{"central", 0.0, true},
                                  Variant{"bending", 1e-2, true}}) {
     SCOPED_TRACE(variant.name);
-    config::CaseConfig c;
-    c.level = 2;
-    c.aspect_ratio = 2.0;
-    c.capillary_number = 0.3;
+    config::CaseConfig c = prolate_case();
     c.bending_modulus = variant.bending_modulus;
     c.central_symmetry = variant.central;
     CapsuleFlow flow(c);
@@ -198,10 +198,7 @@ TEST(CapsuleFlow, VelocityIsTheCompositionOfItsPublicPhases) {
 // bending part is a real part of it (κ_b = 1e-2 on a level-2 mesh); without bending the elastic load is the
 // membrane load, bitwise (the same solve), and the bending load is zero.
 TEST(CapsuleFlow, ElasticAndBendingLoadsSumToTheMembraneLoad) {
-  config::CaseConfig c;
-  c.level = 2;
-  c.aspect_ratio = 2.0;
-  c.capillary_number = 0.3;
+  config::CaseConfig c = prolate_case();
   {
     CapsuleFlow flow(c);
     const Eigen::Matrix3Xd x = sheared_asymmetric(flow.reference());
@@ -236,10 +233,7 @@ TEST(CapsuleFlow, ElasticAndBendingLoadsSumToTheMembraneLoad) {
 // are): the property a linearly implicit step splitting the load relies on. Checked to round-off on an asymmetric
 // scene (so that both loads take the same full evaluation).
 TEST(CapsuleFlow, BoundaryVelocityIsLinearInTheLoadWithoutTheBackgroundFlow) {
-  config::CaseConfig c;
-  c.level = 2;
-  c.aspect_ratio = 2.0;
-  c.capillary_number = 0.3;
+  config::CaseConfig c = prolate_case();
   c.bending_modulus = 1e-2;
   CapsuleFlow flow(c);
   flow.set_background_flow(false);
@@ -275,10 +269,7 @@ class ScaledSolve final : public SecondKindSolve {
 };
 
 TEST(CapsuleFlow, SecondKindSolveSitsBetweenTheSingleLayerAndTheVolumeCorrection) {
-  config::CaseConfig c;
-  c.level = 2;
-  c.aspect_ratio = 2.0;
-  c.capillary_number = 0.3;
+  config::CaseConfig c = prolate_case();
   CapsuleFlow plain(c), identity(c), halved(c);
   identity.set_second_kind_solve(std::make_unique<ScaledSolve>(1.0));
   auto solve = std::make_unique<ScaledSolve>(0.5);
@@ -318,10 +309,7 @@ namespace {
 TEST(CapsuleFlow, VelocityIsBitwiseTheSameOnOneAndTwoThreads) {
   for (const char* precision : {"double", "mixed"}) {  // sum_mixed too: each target's sum is one thread's
     SCOPED_TRACE(precision);
-    config::CaseConfig c;
-    c.level = 2;
-    c.aspect_ratio = 2.0;
-    c.capillary_number = 0.3;
+    config::CaseConfig c = dynamics::prolate_case();
     c.kernel_precision = precision;
     dynamics::CapsuleFlow flow(c);
     const Eigen::Matrix3Xd x = dynamics::sheared_asymmetric(flow.reference());  // all targets, non-trivial loads

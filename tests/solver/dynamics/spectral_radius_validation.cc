@@ -29,7 +29,7 @@ class SpectralRadiusAlongRuns : public testing::TestWithParam<std::tuple<Case, i
 TEST_P(SpectralRadiusAlongRuns, EstimateBoundsThePowerIteration) {
   const auto& [c, level] = GetParam();
   config::CaseConfig cfg;
-  cfg.law = c.law;
+  cfg.law = config::from_word<config::MembraneLawKind>(c.law).value();
   cfg.aspect_ratio = c.aspect_ratio;
   cfg.capillary_number = c.Ca;
   cfg.level = level;
@@ -78,7 +78,7 @@ TEST_P(BendingSpectralRadius, EstimateBoundsThePowerIteration) {
   const auto& [kb, level] = GetParam();
   for (double r : {1.0, 2.0}) {
     config::CaseConfig cfg;
-    cfg.law = "neo-hookean";
+    cfg.law = config::MembraneLawKind::NeoHookean;
     cfg.aspect_ratio = r;
     cfg.capillary_number = 0.1;
     cfg.level = level;

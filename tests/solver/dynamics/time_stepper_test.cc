@@ -18,7 +18,7 @@ config::CaseConfig make_case(int level, double Ca, double aspect_ratio) {
   c.aspect_ratio = aspect_ratio;
   c.level = level;
   c.capillary_number = Ca;
-  c.law = "skalak";
+  c.law = config::MembraneLawKind::Skalak;
   return c;
 }
 
@@ -195,14 +195,15 @@ TEST(Integrators, StartFieldsAreTheFieldsOfTheInitialState) {
   const Eigen::Matrix3Xd x0 = perturbed_reference(flow);
   Eigen::Matrix3Xd v, q;
   flow.velocity(x0, v, &q);
-  for (const char* scheme : {"rk2", "rkc"}) {
+  for (const config::TimeScheme scheme : {config::TimeScheme::Rk2, config::TimeScheme::Rkc}) {
+    SCOPED_TRACE(config::word_of(scheme));
     auto integrator = make_integrator(scheme);
     Eigen::Matrix3Xd x = x0;
     StartFields start;
     integrator->step(flow, x, 0.01, &start);
-    EXPECT_TRUE(start.velocity == v) << scheme;
-    EXPECT_TRUE(start.load == q) << scheme;
-    EXPECT_FALSE(x == x0) << scheme;
+    EXPECT_TRUE(start.velocity == v);
+    EXPECT_TRUE(start.load == q);
+    EXPECT_FALSE(x == x0);
   }
 }
 
@@ -220,7 +221,7 @@ TEST(Rkc, StagesFollowSafetyTimesTheStiffnessEstimate) {
   const double dt = 0.05;
   int previous = 0, first = 0;
   for (double safety : {1.0, kRkcSafety, 2.0, 4.0}) {
-    auto integrator = make_integrator("rkc", safety);
+    auto integrator = make_integrator(config::TimeScheme::Rkc, safety);
     Eigen::Matrix3Xd x = x0;
     const StepInfo info = integrator->step(flow, x, dt);
     const int expected = RkcIntegrator::stages_for(dt * safety * rho, RkcIntegrator::Options{}.damping);
@@ -244,7 +245,7 @@ TEST(Rkc, DefaultStagesCoverThePowerIterationSpectralRadius) {
     const Eigen::Matrix3Xd x = perturbed_reference(flow);
     const double dt = automatic_time_step(c, flow.mesh());
     EXPECT_EQ(dt, c.dt_accuracy) << "the stiff regime: dt set by accuracy";
-    auto rkc = make_integrator("rkc", c.rkc_safety);
+    auto rkc = make_integrator(config::TimeScheme::Rkc, c.rkc_safety);
     Eigen::Matrix3Xd y = x;
     const int s = rkc->step(flow, y, dt).stages;
     const double truth = estimate_spectral_radius(flow, x, 60);
@@ -307,7 +308,7 @@ TEST(Rkc, AutomaticStepKeepsTheStagesWithinReachUnderBending) {
 // reference shape they are exactly what the first step takes (rkc: the stages for the stiffness at rest;
 // rk2: two per step), at the automatic dt or a set time.dt, with and without bending.
 TEST(Rkc, EvaluationsPerUnitTimeAreWhatTheFirstStepAtRestTakes) {
-  for (const std::string scheme : {"rkc", "rk2"})
+  for (const config::TimeScheme scheme : {config::TimeScheme::Rkc, config::TimeScheme::Rk2})
     for (double Ca : {0.02, 0.5, 3.0})
       for (double kb : {0.0, 1e-3})
         for (double set_dt : {0.0, 0.004}) {
@@ -323,7 +324,7 @@ TEST(Rkc, EvaluationsPerUnitTimeAreWhatTheFirstStepAtRestTakes) {
           Eigen::Matrix3Xd x = flow.reference();
           const StepInfo info = integrator->step(flow, x, dt);
           EXPECT_NEAR(evaluations_per_unit_time(c, h) * dt, info.evaluations, 1e-9)
-              << scheme << " Ca " << Ca << " κ_b " << kb << " dt " << dt;
+              << config::word_of(scheme) << " Ca " << Ca << " κ_b " << kb << " dt " << dt;
         }
 }
 

@@ -73,10 +73,10 @@ TEST(MembraneLaw, BadParametersThrow) {
   EXPECT_THROW(SkalakLaw(-0.5), std::invalid_argument);
   EXPECT_THROW(SkalakLaw(-1.0), std::invalid_argument);
   EXPECT_THROW(SkalakLaw(std::nan("")), std::invalid_argument);
-  EXPECT_THROW(make_law("mooney", 1.0), std::invalid_argument);
+  EXPECT_THROW(make_law(config::MembraneLawKind::Skalak, -0.5), std::invalid_argument);
   EXPECT_NO_THROW(SkalakLaw(-0.49));
-  EXPECT_EQ(make_law("neo-hookean", 1.0)->name(), "neo-hookean");
-  EXPECT_EQ(make_law("skalak", 2.0)->name(), "skalak");
+  EXPECT_EQ(make_law(config::MembraneLawKind::NeoHookean, 1.0)->name(), "neo-hookean");
+  EXPECT_EQ(make_law(config::MembraneLawKind::Skalak, 2.0)->name(), "skalak");
 }
 
 }  // namespace

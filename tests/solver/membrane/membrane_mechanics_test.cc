@@ -44,7 +44,7 @@ TEST(AreaVolume, SpheroidEnclosesUnitSphereVolume) {
   }
 }
 
-class MembraneLaws : public ::testing::TestWithParam<std::string> {};
+class MembraneLaws : public ::testing::TestWithParam<config::MembraneLawKind> {};
 
 TEST_P(MembraneLaws, RigidMotionGivesNoForce) {
   const auto law = make_law(GetParam(), 1.0);
@@ -100,10 +100,10 @@ TEST_P(MembraneLaws, InflatedSphereObeysLaplaceLaw) {
   const double lambda = 1.1;
   const double tau = law->tensions(lambda, lambda)[0];
   const double expected = 2.0 * tau / lambda;
-  if (GetParam() == "neo-hookean") {
+  if (GetParam() == config::MembraneLawKind::NeoHookean) {
     EXPECT_NEAR(tau, 1.0 - std::pow(lambda, -6), 1e-14);
   }
-  std::printf("%s, lambda = %.2f, q.n exact = %.6f\n%5s %14s %14s %8s\n", GetParam().c_str(), lambda, expected,
+  std::printf("%s, lambda = %.2f, q.n exact = %.6f\n%5s %14s %14s %8s\n", config::word_of(GetParam()).data(), lambda, expected,
               "level", "max |q.n-p|/p", "max |q_t|/p", "order");
   double prev = 0.0;
   for (int level = 0; level <= 4; ++level) {
@@ -133,7 +133,7 @@ TEST_P(MembraneLaws, InflatedSphereObeysLaplaceLaw) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Laws, MembraneLaws, ::testing::Values("neo-hookean", "skalak"));
+INSTANTIATE_TEST_SUITE_P(Laws, MembraneLaws, ::testing::Values(config::MembraneLawKind::NeoHookean, config::MembraneLawKind::Skalak));
 
 TEST(MembraneMechanics, PrincipalStretchesOfAnAffineStretch) {
   const auto m = mesh::make_sphere_mesh(2);

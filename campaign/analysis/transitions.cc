@@ -4,9 +4,9 @@
 #include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <variant>
 
+#include "campaign/analysis/group_key.h"
 #include "campaign/analysis/refinement.h"
 #include "campaign/grid/decimal.h"
 #include "campaign/grid/precision.h"
@@ -103,49 +103,12 @@ Transition analyse_group(Transition t, std::vector<Sample> samples, double thr) 
 
 bool is_sphere(const Transition& t) { return std::abs(t.aspect_ratio - 1.0) < 1e-9; }
 
-std::string group_key(const CaseParams& params) {
-  // The case identity hashes canonical() ("key=value" lines of the solver's resolved configuration, output keys
-  // left out); the group is that text without the Ca line, so two cases share a group exactly when their
-  // identities differ in Ca only. Values are JSON numbers/booleans where they parse as such, else strings.
-  nlohmann::json j = nlohmann::json::object();
-  std::istringstream lines(params.canonical());
-  std::string line;
-  while (std::getline(lines, line)) {
-    const auto eq = line.find('=');
-    if (eq == std::string::npos) continue;
-    const std::string k = line.substr(0, eq), v = line.substr(eq + 1);
-    // Ca varies within a group; the kernel precision is how a case was computed, not what (both precisions
-    // of a case answer the same question to ~1e-6): a check level run in mixed precision joins its group.
-    // Likewise the stop test: which answer the periodic stop waited for (a multi-fidelity campaign's
-    // stop_for_answer), not the question; the answer it did not wait for carries its period spread.
-    if (k == "flow.capillary_number" || k == "numerics.kernel_precision" || k == "time.stop_test") continue;
-    auto parsed = nlohmann::json::parse(v, nullptr, false);
-    j[k] = (!parsed.is_discarded() && (parsed.is_number() || parsed.is_boolean() || parsed.is_string()))
-               ? parsed
-               : nlohmann::json(v);
-  }
-  return j.dump();
-}
-
-std::string group_difference(const std::string& a, const std::string& b) {
-  const auto ja = nlohmann::json::parse(a, nullptr, false), jb = nlohmann::json::parse(b, nullptr, false);
-  if (!ja.is_object() || !jb.is_object()) return "";
-  std::string out;
-  auto text = [](const nlohmann::json& j, const std::string& k) { return j.contains(k) ? j[k].dump() : "unset"; };
-  std::map<std::string, bool> keys;
-  for (auto& [k, _] : ja.items()) keys[k] = true;
-  for (auto& [k, _] : jb.items()) keys[k] = true;
-  for (const auto& [k, _] : keys)
-    if (text(ja, k) != text(jb, k)) out += (out.empty() ? "" : ", ") + k + " (" + text(ja, k) + " vs " + text(jb, k) + ")";
-  return out;
-}
-
 std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases) {
   std::map<std::string, std::size_t> index;
   std::vector<std::vector<int>> sample_rank;  // per group, aligned with its samples (preference, see below)
   std::vector<SampleGroup> out;
   for (const auto& c : cases) {
-    const std::string key = group_key(c.params);
+    const std::string key = GroupKey::of(c.params).str();
     auto [it, inserted] = index.try_emplace(key, out.size());
     if (inserted) {
       SampleGroup g;

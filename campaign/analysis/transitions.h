@@ -18,8 +18,8 @@ namespace capsim::campaign {
 
 /// @brief Critical capillary numbers of one group of cases (every identity key equal except Ca).
 struct Transition {
-  /// @brief Canonical JSON object of every identity key of the group except flow.capillary_number (the
-  /// solver's resolved values, as in the case identity): two groups differ exactly when this differs.
+  /// @brief GroupKey::str() of the group (analysis/group_key.h): two groups differ exactly when this differs;
+  /// "" in a version-2 row.
   std::string group_key;
   std::string law;                     ///< membrane law (also in group_key; a column for queries)
   double aspect_ratio = 0;             ///< a/b
@@ -96,18 +96,9 @@ struct SampleGroup {
   CaseParams base;                      ///< one case of the group: the template of new cases
 };
 
-/// @brief The group key of a case: canonical JSON of its identity keys except Ca, numerics.kernel_precision
-/// (how a case was computed, not what: both precisions agree to ~1e-6 in min D12, results/speed/mixed_ab_case.json)
-/// and time.stop_test (which answer its stop waited for; the other carries its period spread).
-std::string group_key(const CaseParams& params);
-
-/// @brief The keys in which two group keys differ, as "key (a vs b), ..." (for messages); "" if equal or
-/// either is not a JSON object (a version-2 row).
-std::string group_difference(const std::string& group_key_a, const std::string& group_key_b);
-
-/// @brief Groups cases by group_key (groups in order of first appearance); a group with no done case is
+/// @brief Groups cases by GroupKey (groups in order of first appearance); a group with no done case is
 /// still listed (empty samples). Cases that differ in numerics.kernel_precision or time.stop_test only share
-/// a group (see group_key); a Ca done more than once gives one sample: the double one, then the one whose
+/// a group (see GroupKey); a Ca done more than once gives one sample: the double one, then the one whose
 /// stop test was "both". @throws
 /// capsim::config::ConfigError for a case the solver rejects.
 std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases);

@@ -5,8 +5,6 @@
 #include <map>
 #include <set>
 
-#include <nlohmann/json.hpp>
-
 #include "campaign/analysis/refinement.h"
 #include "campaign/grid/precision.h"
 
@@ -34,9 +32,8 @@ std::vector<const Sample*> with_value(const SampleGroup& g, Quantity q) {
 }
 
 std::string group_dt(const std::string& group_key) {
-  const auto j = nlohmann::json::parse(group_key, nullptr, false);
-  if (!j.is_object() || !j.contains("time.dt")) return "auto";
-  return j["time.dt"].is_string() ? j["time.dt"].get<std::string>() : j["time.dt"].dump();
+  const auto k = GroupKey::parse(group_key);
+  return k ? k->dt() : "auto";
 }
 
 std::string num(double x) { return format_significant(x, 2); }
@@ -440,14 +437,6 @@ LevelCrossing check_level_crossing(const SampleGroup& g, const std::vector<doubl
     y0 = *y;
   }
   return {line, true};
-}
-
-std::string cell_key(const std::string& group_key) {
-  auto j = nlohmann::json::parse(group_key, nullptr, false);
-  if (!j.is_object()) return group_key;
-  j.erase("mesh.level");
-  j.erase("time.dt");
-  return j.dump();
 }
 
 std::vector<std::string> group_roles(const std::vector<SampleGroup>& groups, const ErrorOptions& options) {

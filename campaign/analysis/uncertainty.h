@@ -59,12 +59,10 @@
 #include <string>
 #include <vector>
 
+#include "campaign/analysis/group_key.h"
 #include "campaign/analysis/transitions.h"
 
 namespace capsim::campaign {
-
-/// @brief The key of the cell of a group: its group_key without mesh.level and time.dt.
-std::string cell_key(const std::string& group_key);
 
 /// @brief How a campaign's levels are used ([analysis] levels): empty = every group is an answer group
 /// (table1 prints the finest level; a time.dt axis is a study of its own, its groups are not dt checks);

@@ -12,6 +12,7 @@
 
 #include "campaign/cli/cli_app.h"
 #include "campaign/cli/commands.h"
+#include "campaign/analysis/group_key.h"
 #include "campaign/common/bad_input.h"
 #include "campaign/grid/decimal.h"
 #include "campaign/grid/precision.h"
@@ -37,18 +38,16 @@ using campaign::BadInput;
 const std::set<std::string> kShownKeys = {"capsule.law", "capsule.aspect_ratio", "capsule.skalak_C", "mesh.level"};
 
 std::vector<std::string> varying_keys(const std::vector<std::string>& group_keys) {
-  std::map<std::string, std::set<std::string>> values;  // key -> the values it takes ("" where absent)
-  std::vector<nlohmann::json> parsed;
-  for (const auto& g : group_keys) {
-    parsed.push_back(nlohmann::json::parse(g, nullptr, false));
-    if (parsed.back().is_object())
-      for (const auto& [k, _] : parsed.back().items())
-        if (!kShownKeys.count(k)) values[k];
-  }
-  for (const auto& j : parsed) {
-    if (!j.is_object()) continue;  // a version-2 row: no group key
-    for (auto& [k, vs] : values) vs.insert(j.contains(k) ? j[k].dump() : "");
-  }
+  std::map<std::string, std::set<std::string>> values;  // key -> the values it takes ("unset" where absent)
+  std::vector<campaign::GroupKey> parsed;
+  for (const auto& g : group_keys)
+    if (auto k = campaign::GroupKey::parse(g)) {  // a version-2 row has no group key
+      for (const auto& name : k->keys())
+        if (!kShownKeys.count(name)) values[name];
+      parsed.push_back(std::move(*k));
+    }
+  for (const auto& k : parsed)
+    for (auto& [name, vs] : values) vs.insert(k.json_text(name));
   std::vector<std::string> out;
   for (const auto& [k, vs] : values)
     if (vs.size() > 1) out.push_back(k);
@@ -58,12 +57,12 @@ std::vector<std::string> varying_keys(const std::vector<std::string>& group_keys
 // "capsule.bending_modulus=0.001, time.dt=0.01" for @p keys of @p group_key (a key left at its default is not
 // in the group key: the registry's default is shown).
 std::string key_values(const std::string& group_key, const std::vector<std::string>& keys) {
-  const auto j = nlohmann::json::parse(group_key, nullptr, false);
+  const auto key = campaign::GroupKey::parse(group_key);
   std::string out;
   for (const auto& k : keys) {
     std::string v;
-    if (j.is_object() && j.contains(k)) v = j[k].is_string() ? j[k].get<std::string>() : j[k].dump();
-    else if (const auto* key = config::find_case_key(k)) v = config::shortest_text(key->default_value);
+    if (key) v = key->text(k);
+    else if (const auto* registered = config::find_case_key(k)) v = config::shortest_text(registered->default_value);
     out += (out.empty() ? "" : ", ") + k + "=" + v;
   }
   return out;

@@ -12,6 +12,7 @@
 
 #include "campaign/cli/cli_app.h"
 #include "campaign/cli/commands.h"
+#include "campaign/analysis/group_key.h"
 #include "campaign/analysis/uncertainty.h"
 #include "campaign/common/bad_input.h"
 #include "campaign/grid/decimal.h"
@@ -46,10 +47,8 @@ SqlValue value_of(const std::optional<double>& x) { return x ? SqlValue{*x} : Sq
 
 // capsule.bending_modulus of a transition group (stored only when set: absent means 0, the seed's membrane).
 double bending_modulus_of(const std::string& group_key) {
-  const auto j = nlohmann::json::parse(group_key, nullptr, false);
-  if (j.is_object() && j.contains("capsule.bending_modulus") && j["capsule.bending_modulus"].is_number())
-    return j["capsule.bending_modulus"].get<double>();
-  return 0.0;
+  const auto key = campaign::GroupKey::parse(group_key);
+  return key ? key->bending_modulus() : 0.0;
 }
 
 // Every stored field of @p rows (of campaign @p campaign_of[i]) as the JSON and CSV of `query table1` and

@@ -233,7 +233,7 @@ class Runner {
     std::map<std::string, std::string> cell;  // case id -> cell_key
     std::map<std::pair<int, std::string>, double> queued_work;  // (mesh level, cell) -> work left of its queued cases
     for (const auto& r : pending) {
-      const std::string c = cell_key(group_key(r.params));
+      const std::string c = GroupKey::of(r.params).cell().str();
       cell[r.case_id] = c;
       queued_work[{r.params.mesh_level(), c}] += left.at(r.case_id);
     }
@@ -257,8 +257,8 @@ class Runner {
   void close_rounds(const std::vector<CaseRow>& pending) {
     if (started_cells_.empty()) return;
     std::set<std::string> live;
-    for (const auto& [_, r] : running_) live.insert(cell_key(group_key(r.row.params)));
-    for (const auto& r : pending) live.insert(cell_key(group_key(r.params)));
+    for (const auto& [_, r] : running_) live.insert(GroupKey::of(r.row.params).cell().str());
+    for (const auto& r : pending) live.insert(GroupKey::of(r.params).cell().str());
     std::erase_if(started_cells_, [&](const std::string& c) { return live.count(c) == 0; });
   }
 
@@ -282,7 +282,7 @@ class Runner {
   }
 
   void start(CaseRow row) {
-    if (coarse_levels_first_) started_cells_.insert(cell_key(group_key(row.params)));
+    if (coarse_levels_first_) started_cells_.insert(GroupKey::of(row.params).cell().str());
     row.out_dir = prepare_case_folder(row, runs_dir_);
     store_.set_case_folder(row.case_id, row.out_dir);
     const std::string toml = row.out_dir + "/case.toml";
@@ -434,7 +434,7 @@ int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& 
       for (const auto& p : *unfinished) levels.push_back(p.mesh_level());
       if (!rounds_may_overlap(mf, levels)) {
         std::set<std::string> busy;
-        for (const auto& p : *unfinished) busy.insert(cell_key(group_key(p)));
+        for (const auto& p : *unfinished) busy.insert(GroupKey::of(p).cell().str());
         std::erase_if(groups, [&](const SampleGroup& g) { return busy.count(cell_key(g.key.group_key)) > 0; });
       }
     }
@@ -469,7 +469,7 @@ int refine_campaign(Store& store, std::int64_t campaign_id, const CampaignSpec& 
   t.commit();
   if (cell_rounds) {
     std::set<std::string> cells;
-    for (const auto& p : add) cells.insert(cell_key(group_key(p)));
+    for (const auto& p : add) cells.insert(GroupKey::of(p).cell().str());
     for (const auto& c : cells) ++(*cell_rounds)[c];
   }
   return added;

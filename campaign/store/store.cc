@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <regex>
 
+#include "campaign/analysis/group_key.h"
 #include "campaign/common/bad_input.h"
 #include "campaign/common/exit_codes.h"
 #include "capsim/schema_sql.h"
@@ -721,7 +722,7 @@ std::vector<ProblemCase> Store::problem_cases(std::int64_t campaign_id, int limi
     p.error = s.text(5);
     p.mesh_level = static_cast<int>(s.integer(6));
     const CaseParams params = CaseParams::from_json(s.text(7));
-    p.group_key = group_key(params);
+    p.group_key = GroupKey::of(params).str();
     p.out_dir = s.text(8);
     p.t_end = params.t_end();
     out.push_back(std::move(p));

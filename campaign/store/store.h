@@ -71,7 +71,7 @@ struct ProblemCase {
   std::string case_id, law, status, error;  ///< identity, law, status, last error
   double aspect_ratio = 0, capillary_number = 0;  ///< a/b, Ca
   int mesh_level = 0;                       ///< mesh level
-  std::string group_key;                    ///< its transition group (analysis/transitions.h group_key)
+  std::string group_key;                    ///< its transition group (GroupKey::str(), analysis/group_key.h)
   std::string out_dir;                      ///< its case folder ("" before its first start)
   double t_end = 0;                         ///< time.t_end of the case
 };

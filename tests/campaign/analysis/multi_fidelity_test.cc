@@ -401,7 +401,7 @@ TEST(MultiFidelity, CasesThatDifferInTheirStopTestShareAGroup) {
     return c;
   };
   const CaseSample plain = fake(3, 0.5, [](double) { return -1.0; });
-  EXPECT_EQ(group_key(plain.params), group_key(stopping(plain, "min_D12", 0).params));
+  EXPECT_EQ(GroupKey::of(plain.params).str(), GroupKey::of(stopping(plain, "min_D12", 0).params).str());
   EXPECT_NE(plain.params.identity("2"), stopping(plain, "min_D12", 0).params.identity("2"));
   EXPECT_EQ(plain.params.identity("2"), stopping(plain, "both", 0).params.identity("2"))
       << "the default is not in the identity";

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "campaign/analysis/group_key.h"
 #include "campaign/analysis/refinement.h"
 #include "campaign/analysis/transitions.h"
 
@@ -67,7 +68,7 @@ TEST(TransitionGroups, EveryIdentityKeyButCaSeparatesGroups) {
   EXPECT_NE(groups[0].key.group_key, groups[1].key.group_key);
   EXPECT_NE(group_difference(groups[0].key.group_key, groups[1].key.group_key).find("time.dt"), std::string::npos);
   // Ca alone never separates: the same case at another Ca has the same key.
-  EXPECT_EQ(group_key(cases[0].params), group_key(cases[1].params));
+  EXPECT_EQ(GroupKey::of(cases[0].params), GroupKey::of(cases[1].params));
 }
 
 }  // namespace

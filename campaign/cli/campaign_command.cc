@@ -1,5 +1,4 @@
 // `capsim campaign run|submit|collect|import|analyse|status`: the campaign manager's command line.
-#include <nlohmann/json.hpp>
 
 #include <cstdio>
 #include <exception>

@@ -1,5 +1,4 @@
 // `capsim query table1|cases|transitions|sql`: read-only queries of a campaign database.
-#include <nlohmann/json.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

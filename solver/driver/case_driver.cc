@@ -126,7 +126,7 @@ class CaseRun {
       // resumed case reports what the uninterrupted one would (the campaigns' core-hours rest on it).
       evaluations_before_ = static_cast<long>(cp.scalars["flow_evaluations"]);
       wall_before_ = cp.scalars["wall_s"];
-      // The same for the phase times (absent before 2026-12-06: 0, so a case resumed from such a checkpoint
+      // The same for the phase times (absent from older checkpoints: 0, so a case resumed from such a checkpoint
       // reports the phases of its later invocations only, while wall_s covers all).
       membrane_before_ = cp.scalars["membrane_s"];
       load_before_ = cp.scalars["load_s"];

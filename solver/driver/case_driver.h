@@ -58,7 +58,7 @@ struct CaseResult {
   diagnostics::WrinkleIndicators wrinkle_final, wrinkle_max;
   long steps = 0;
   /// Cost of the case: a resumed case counts every invocation (the checkpoint carries the totals so far), in
-  /// flow_evaluations, wall_s and the phase times alike. (Checkpoints written before 2026-12-06 carry no phase
+  /// flow_evaluations, wall_s and the phase times alike. (Older checkpoints carry no phase
   /// times: a case resumed from one reports the phases of its later invocations only.)
   long flow_evaluations = 0;        ///< velocity evaluations of the time steps (snapshots reuse a step's own)
   double dt = 0;

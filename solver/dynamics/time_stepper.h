@@ -16,7 +16,7 @@
 /// dt. On level 3 rkc's accuracy dt (0.02) is above rk2's stable dt up to Ca = 0.9 at least, and rkc takes
 /// its 2-stage minimum (where rk2, with the same stability interval, could only match it) only at dt ≈ 0.005.
 /// The measurements (evaluations per unit time, errors against rk2 at half its dt, volume drift) are in
-/// results/benchmarks.md, "Time integration" and "Evaluations per unit time (issue 13 §2)".
+/// results/benchmarks.md, "Time integration" and "Evaluations per unit time".
 
 #include <memory>
 #include <stdexcept>
@@ -71,12 +71,12 @@ class TimeIntegrator {
 };
 
 /// @brief Default safety factor of the RKC stage choice (time.rkc_safety; case_keys.def has the same default).
-/// Measured (issue 13 §2, results/time_steps): along runs of three level-2 cases (Ca = 0.02–0.9, a/b = 0.5 and
+/// Measured (results/time_steps): along runs of three level-2 cases (Ca = 0.02–0.9, a/b = 0.5 and
 /// 2, both laws) membrane_spectral_radius is 1.17–1.49 × the power-iteration ρ, so with 1.25 the stages cover
 /// ρ 1.46–1.86 times. Safety 1.0 saves 8–11% of the evaluations on the level-3 cases (a) and (b) and changed
 /// D12 by < 1e-6; it is not the default because the level-3 comparison (where the spheroid calibration
 /// above found ρ Ca h_min up to 6.1 against K = 6.5, a 7% margin) and a stability sweep were not done.
-/// 2026-12-06 (results/benchmarks.md, "The main command over time"): the main preset's 103 cases (Table 1
+/// Then (results/benchmarks.md, "The main command over time"): the main preset's 103 cases (Table 1
 /// grid, levels 2–3, κ_b = 0, Ca 0.01–3.5, both laws) all ran stably with 1.0, 10.8% / 9.2% fewer
 /// evaluations on levels 2 / 3, every answer within 2.5e-4 of its error; table1_mf_mixed.toml now sets 1.0.
 /// The default stays 1.25: changing it would change the identity of every committed case, and bending and

@@ -29,8 +29,8 @@ CaseParams a_case(double ca, int level) {
 // file (the certified table).
 TEST(GroupKey, TheStoredKeysOfTheCommittedDatabasesAreBitwiseWhatACaseGives) {
   int checked = 0;
-  for (const char* name : {"results/main_command_15min/table1_mf_mixed.sqlite", "results/bending/table1_bending.sqlite",
-                           "results/table1_certified.sqlite"}) {
+  for (const char* name : {"results/table1/table1_mf_mixed.sqlite", "results/bending/table1_bending.sqlite",
+                           "results/table1_certified/table1_certified.sqlite"}) {
     auto store = Store::open_readonly(std::string(CAPSIM_SOURCE_DIR) + "/" + name);
     std::map<std::int64_t, std::set<std::string>> of_cases;  // campaign -> keys of its cases
     Stmt cases(store->db(),

@@ -65,20 +65,20 @@ class Progress {
 class EtaModel {
  public:
   /// @brief What a whole case costs per mesh level finer, as measured: the geometric mean of the wall-time
-  /// ratios of the same case on consecutive levels in the committed databases (2026-12-03: 8.7 over 90
+  /// ratios of the same case on consecutive levels in the committed databases (8.7 over 90
   /// level-2/3 pairs, 9.5 over 5 level-3/4 pairs; single pairs range 1.1-24). Only an ETA's first guess for
   /// a level that has no finished case yet.
   static constexpr double kMeasuredPerLevel = 9.0;
   /// @brief What the estimate of the same case grows per mesh level finer: the geometric mean over the 44
-  /// level-2/3 and 3/4 pairs of table1_certified.sqlite (2026-12-05: 11.9, pairs 9–15; 17.9 over the 57 pairs
-  /// of bending/table1_bending.sqlite, where the bending stiffness grows as h^−2).
+  /// level-2/3 and 3/4 pairs of results/table1_certified/table1_certified.sqlite (11.9, pairs 9–15; 17.9 over the 57 pairs
+  /// of results/bending/table1_bending.sqlite, where the bending stiffness grows as h^−2).
   static constexpr double kEstimatePerLevel = 12.0;
-  /// @brief The exponent β of wall ∝ est_cost^β within one level, as measured (2026-12-05, least squares in
+  /// @brief The exponent β of wall ∝ est_cost^β within one level, as measured (least squares in
   /// log-log; EtaModel.TheCostExponentIsTheFitOfTheCommittedDatabases redoes it): 0.74 over the 106 level-3
-  /// cases of table1.sqlite; 0.82 / 0.81 over 46 level-2 / 66 level-3 cases of table1_certified.sqlite;
-  /// 0.73 / 0.82 over 46 / 57 of table1_mf_mixed.sqlite; 0.55 / 0.75 over 112 / 161 of
-  /// bending/table1_bending.sqlite. (With the estimate ∝ 1/Ca before 2026-12-05 it was 0.19–0.33, and the
-  /// residual spread in log wall was up to 20% larger.)
+  /// cases of results/table1_paper/table1_paper.sqlite; 0.82 / 0.81 over 46 level-2 / 66 level-3 cases of
+  /// results/table1_certified/table1_certified.sqlite; 0.61 / 0.64 over the main command's run
+  /// results/table1/table1_mf_mixed.sqlite; 0.55 / 0.75 over 112 / 161 of results/bending/table1_bending.sqlite.
+  /// (With an estimate ∝ 1/Ca it was 0.19–0.33, and the residual spread in log wall was up to 20% larger.)
   static constexpr double kCostExponent = 0.75;
   /// @brief How strongly β is drawn to kCostExponent: the Σ (log est − mean)² of a prior of that weight.
   static constexpr double kPriorWeight = 4.0;

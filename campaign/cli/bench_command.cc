@@ -1,7 +1,7 @@
 // `capsim bench kernel [--json] [--threads N] [--repeat R]`: the Stokeslet kernel on a level-3-sized problem
 // (2562 targets × all regular quadrature points of the level-3 sphere), fast kernel against the plain
 // `omp simd` loop, so users can check a new machine (issue 6 §1).
-// `capsim bench flow [--level L] [--bending KB] [--precision double|mixed] [--json] [--threads N] [--repeat R]`: one
+// `capsim bench flow [--level L] [--bending KB] [--precision double|mixed] [--set KEY=VALUE]... [--json] [--threads N] [--repeat R]`: one
 // flow evaluation by named phase against the bare regular Stokeslet sum in the same run
 // (solver/dynamics/flow_benchmark.h, issue 13 §1); with --precision mixed also against the double evaluation.
 #include <omp.h>
@@ -28,7 +28,7 @@ namespace sk = capsim::stokes::kernel;
 void usage_error(const std::string& msg) {
   std::fprintf(stderr,
                "capsim bench: %s (usage: capsim bench kernel [--json] [--threads N] [--repeat R]; "
-               "capsim bench flow [--level L] [--bending KB] [--precision double|mixed] [--json] [--threads N] [--repeat R])\n",
+               "capsim bench flow [--level L] [--bending KB] [--precision double|mixed] [--set KEY=VALUE]... [--json] [--threads N] [--repeat R])\n",
                msg.c_str());
 }
 
@@ -79,6 +79,7 @@ struct BenchArgs {
   int threads = 0, repeat = 0, level = 3;
   double bending = 0.0;
   std::string precision = "double";
+  std::vector<std::string> overrides;  // --set section.key=value of the scene
 };
 
 // Parses the options after the benchmark's name; `level` only where allowed. False after a usage error.
@@ -101,6 +102,12 @@ bool parse_args(const std::vector<std::string>& args, bool allow_level, BenchArg
       }
       out.bending = v;  // its range is the key registry's, checked by FlowBenchOptions::valid
       ++k;
+    } else if (allow_level && a == "--set") {
+      if (k + 1 >= args.size()) {
+        usage_error("--set needs section.key=value");
+        return false;
+      }
+      out.overrides.push_back(args[++k]);  // read and checked by FlowBenchOptions::valid against the key registry
     } else if (allow_level && a == "--precision") {
       if (k + 1 >= args.size()) {
         usage_error("--precision needs a value (numerics.kernel_precision)");
@@ -133,6 +140,7 @@ int bench_flow(const BenchArgs& ba) {
   opt.repeat = ba.repeat;
   opt.bending_modulus = ba.bending;
   opt.kernel_precision = ba.precision;
+  opt.overrides = ba.overrides;
   if (std::string why; !opt.valid(&why)) {
     usage_error(why);
     return kExitBadInput;
@@ -162,6 +170,9 @@ int bench_flow(const BenchArgs& ba) {
                         {"singular_ms", s.singular_ms},
                         {"near_ms", s.near_ms},
                         {"volume_ms", s.volume_ms},
+                        {"second_kind_ms", s.second_kind_ms},
+                        {"gmres_iterations", s.gmres_iterations},
+                        {"evaluation_equal_viscosity_ms", s.evaluation_equal_viscosity_ms},
                         {"other_ms", s.other_ms}});
     // The symmetric scene's fields also at the top level: the figure the issue's goal is stated in.
     const auto& sym = r.scenes.front();
@@ -192,6 +203,12 @@ int bench_flow(const BenchArgs& ba) {
   std::printf("ratio = evaluation / bare regular sum (double) over the same targets and sources (medians of %d, "
               "alternated); phases are means per evaluation in ms\n",
               r.scenes.front().repeat);
+  for (const auto& s : r.scenes)
+    if (s.evaluation_equal_viscosity_ms > 0.0)
+      std::printf("%s: viscosity-ratio evaluation %.3f ms (second-kind solve %.3f ms, %.1f GMRES iterations, cold), "
+                  "λ = 1 %.3f ms (alternated in this run): %.2fx\n",
+                  s.name.c_str(), s.evaluation_ms, s.second_kind_ms, s.gmres_iterations,
+                  s.evaluation_equal_viscosity_ms, s.evaluation_ms / s.evaluation_equal_viscosity_ms);
   if (ba.precision != "double")
     for (const auto& s : r.scenes)
       std::printf("%s: %s evaluation %.3f ms, double %.3f ms (alternated in this run): %.2fx faster\n", s.name.c_str(),

@@ -31,6 +31,10 @@ struct FlowBenchOptions {
   /// numerics.kernel_precision of the evaluation: "double" or "mixed". With "mixed" the same scene is also
   /// evaluated in double, alternately in the same run (FlowBenchScene::evaluation_double_ms): the speed-up.
   std::string kernel_precision = "double";
+  /// Further `section.key=value` case keys of the scene (`--set`), applied last, read and checked as `capsim run
+  /// --set` reads them. With flow.viscosity_ratio ≠ 1 the scene is also evaluated at λ = 1, alternately in the
+  /// same run (FlowBenchScene::evaluation_equal_viscosity_ms).
+  std::vector<std::string> overrides;
   /// @brief Whether the options are usable; if not and why is not null, *why says which and why (the case
   /// keys' ranges are the key registry's: the message names the key).
   [[nodiscard]] bool valid(std::string* why = nullptr) const;
@@ -61,6 +65,11 @@ struct FlowBenchScene {
   double singular_ms = 0.0;     ///< Duffy correction
   double near_ms = 0.0;         ///< near-singular correction and mirror
   double volume_ms = 0.0;       ///< velocity assembly, node normals, flux, volume correction
+  double second_kind_ms = 0.0;  ///< the viscosity-ratio solve (0 at λ = 1)
+  /// Mean GMRES iterations per evaluation of the viscosity-ratio solve (0 at λ = 1). Every timed evaluation starts
+  /// a step (CapsuleFlow::begin_step): a cold solve, the first stage of a step, the dearest.
+  double gmres_iterations = 0.0;
+  double evaluation_equal_viscosity_ms = 0.0;  ///< the same scene at λ = 1, alternated (0 when λ = 1 already)
   double other_ms = 0.0;        ///< mean evaluation time not in a named phase (timers, copies)
 };
 

@@ -71,13 +71,15 @@ TEST(ViscosityContrast, UnloadedSphereInShearMovesAsTheExactDrop) {
       err.push_back((v - exact).cwiseAbs().maxCoeff());
       std::printf("  λ = %5.2f level %d: max error %.3e, GMRES iterations %d\n", lambda, level, err.back(),
                   flow.second_kind_statistics().max_iterations);
-      if (lambda == 1.0) EXPECT_EQ(flow.second_kind_statistics().solves, 0);
+      if (lambda == 1.0) {
+        EXPECT_EQ(flow.second_kind_statistics().solves, 0);
+      }
     }
     if (lambda == 1.0) {
       EXPECT_LT(err.back(), 1e-12);
     } else {
       EXPECT_LT(err[1], err[0] / 4.0) << "λ " << lambda;
-      EXPECT_LT(err[0], 1e-2) << "λ " << lambda;
+      EXPECT_LT(err[0], 1e-3) << "λ " << lambda;
     }
   }
 }

@@ -171,10 +171,11 @@ inline constexpr double kBendingSpectralConstant = 45.0;
 /// double layer's principal value vanishes (T·n = 0 for r in the tangent plane) and the second-kind equation
 /// reduces to (1 + λ)/2 · v = f: both fluids resist the membrane, and its relaxation rates are those of λ = 1
 /// times 2/(1 + λ). Measured by power iteration on dv/dx (estimate_spectral_radius) at the reference
-/// spheroids, level 2 (results/validation/README.md, "Viscosity ratio: stiffness"): ρ(λ)/ρ(1) follows
-/// 2/(1 + λ) at λ = 0.1 and 10 to within a few percent, see the table there. The automatic rk2 dt is divided
-/// by it and the RKC stages follow it (membrane_spectral_radius), so at λ = 10 a step costs the stages of a
-/// membrane 5.5 times softer and at λ = 0.1 of one 1.8 times stiffer.
+/// spheroids a/b = 0.5, 1, 2, level 2, Ca = 0.05 (results/validation/README.md, "Viscosity ratio", "Stiffness"):
+/// ρ(λ)/ρ(1) = 1.77–1.79 at λ = 0.1 (2/(1 + λ) = 1.82) and 0.185–0.188 at λ = 10 (0.182), and the scaled
+/// estimate keeps a margin of 1.24–1.41 over the power iteration (1.26–1.37 at λ = 1). The automatic rk2 dt is
+/// divided by it and the RKC stages follow it (membrane_spectral_radius), so at λ = 10 a step costs the stages
+/// of a membrane 5.5 times softer and at λ = 0.1 of one 1.8 times stiffer.
 inline double viscosity_stiffness_factor(double viscosity_ratio) { return 2.0 / (1.0 + viscosity_ratio); }
 
 /// @brief The estimate above for a smallest node spacing @p h_min: the one formula, which the mesh form

@@ -3,6 +3,7 @@
 // limit of a large λ at small Ca, whose shape turns with Jeffery's period.
 #include "solver/driver/case_driver.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +11,8 @@
 #include <string>
 
 #include <gtest/gtest.h>
+
+#include "solver/io/case_file.h"
 
 namespace capsim::driver {
 namespace {
@@ -30,35 +33,40 @@ CaseResult run(config::CaseConfig c, const std::string& name) {
   return r;
 }
 
-// Small deformation of an initially spherical neo-Hookean capsule (Barthès-Biesel & Sgaier 1985): the steady
-// D12 = 25/12 Ca and θ = π/4 at first order in Ca, for every λ (the interior viscosity enters at second order,
-// and in the time to reach the steady shape, which grows with λ). At Ca = 0.02: D12 = 0.04167. Tolerance 10%:
-// the O(Ca) relative correction (a few percent at Ca = 0.02, the λ = 1 test at Ca = 0.3 is 35% below the linear
-// theory) plus the level-2 mesh error; θ within 5° of 45° (the first correction is O(Ca) in radians).
+// Small deformation of an initially spherical neo-Hookean capsule (Barthès-Biesel & Sgaier 1985): D12 = 25/12 Ca
+// and θ = π/4 at first order in Ca, for every λ; the interior viscosity enters at second order and in the time to
+// reach the deformed shape, which grows like (1 + λ)/2. As the λ = 1 test (case_driver_test.cc,
+// SphereMatchesSmallDeformationTheory): Ca = 0.01, level 2, the plateau of one time unit after the deformed shape
+// is reached (γ̇t ≥ 0.5 · max(1, (1 + λ)/2); later the compressed membrane wrinkles slowly) is compared. D12 within 2%
+// (the λ = 1 test holds 1%; at λ ≠ 1 a second-order term of relative size O(Ca) is added); θ in (40°, 45°] (its
+// first correction is O(Ca) with a λ-dependent coefficient: 44.2° at λ = 0.2, 41.8° at λ = 5).
 TEST(ViscosityRatioSphere, SmallDeformationLimitDoesNotDependOnLambda) {
-  const double Ca = 0.02;
-  double d12_equal = 0.0;
-  for (const double lambda : {1.0, 0.2, 5.0}) {
+  const double Ca = 0.01;
+  const double theory = 25.0 / 12.0 * Ca;
+  for (const double lambda : {0.2, 5.0}) {
     config::CaseConfig c;
     c.aspect_ratio = 1.0;
     c.law = "neo-hookean";
     c.capillary_number = Ca;
     c.level = 2;
-    c.t_end = 6.0;
+    const double t0 = 0.5 * std::max(1.0, (1.0 + lambda) / 2.0);
+    c.t_end = t0 + 0.5;
     c.viscosity_ratio = lambda;
-    const CaseResult r = run(c, "sphere_lambda_" + std::to_string(lambda));
+    const std::string name = "sphere_lambda_" + std::to_string(lambda);
+    const CaseResult r = run(c, name);
     ASSERT_EQ(r.status, "done") << r.reason;
-    EXPECT_EQ(r.analysis.regime, diagnostics::Regime::steady) << "λ " << lambda;
-    EXPECT_NEAR(r.analysis.mean_D12, 25.0 / 12.0 * Ca, 0.1 * 25.0 / 12.0 * Ca) << "λ " << lambda;
-    EXPECT_NEAR(r.analysis.theta_mean * 180.0 / std::numbers::pi, 45.0, 5.0) << "λ " << lambda;
-    if (lambda == 1.0) {
-      d12_equal = r.analysis.mean_D12;
-      EXPECT_EQ(r.gmres_iterations_max, 0);
-    } else {
-      EXPECT_GT(r.gmres_iterations_mean, 0.0);
-      // Independent of λ at first order: the λ-dependence is a second-order effect, a few percent of D12.
-      EXPECT_NEAR(r.analysis.mean_D12, d12_equal, 0.05 * d12_equal) << "λ " << lambda;
+    EXPECT_GT(r.gmres_iterations_mean, 0.0);
+    const auto series = io::read_case_file(fs::path(CAPSIM_TEST_TMP) / "validation" / name / "case.h5").series;
+    int checked = 0;
+    for (std::size_t i = 0; i < series.size(); ++i) {
+      if (series.t[i] < t0) continue;
+      EXPECT_NEAR(series.D12[i], theory, 0.02 * theory) << "λ " << lambda << " t = " << series.t[i];
+      const double theta_deg = series.theta[i] * 180.0 / std::numbers::pi;
+      EXPECT_GT(theta_deg, 40.0) << "λ " << lambda;
+      EXPECT_LE(theta_deg, 45.0) << "λ " << lambda;
+      ++checked;
     }
+    EXPECT_GT(checked, 5) << "λ " << lambda;
   }
 }
 

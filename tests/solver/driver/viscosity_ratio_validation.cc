@@ -1,5 +1,5 @@
-// Whole cases at a viscosity ratio λ ≠ 1 (label `validation`; minutes each, level 2): the small-deformation limit
-// of a sphere, whose steady D12 and inclination do not depend on λ at first order in Ca, and the rigid-spheroid
+// Whole cases at a viscosity ratio λ ≠ 1 (label `validation`; seconds to minutes each, level 2): the small-deformation
+// limit of a sphere, whose D12 and inclination do not depend on λ at first order in Ca, and the rigid-spheroid
 // limit of a large λ at small Ca, whose shape turns with Jeffery's period.
 #include "solver/driver/case_driver.h"
 
@@ -70,22 +70,30 @@ TEST(ViscosityRatioSphere, SmallDeformationLimitDoesNotDependOnLambda) {
   }
 }
 
-// A viscous interior (λ = 10) and a stiff membrane (Ca = 0.05) on an a/b = 2 prolate spheroid: the capsule tumbles
-// as a rigid spheroid, whose shape (D12) repeats every half Jeffery period π(r + 1/r) = 7.854 for r = 2 (the full
-// rotation 2π(r + 1/r)). Tolerance 5%: the residual deformation and tank-treading at finite λ and Ca.
-TEST(ViscosityRatioSpheroid, LargeLambdaTumblesWithJefferysPeriod) {
-  config::CaseConfig c;
-  c.aspect_ratio = 2.0;
-  c.law = "skalak";
-  c.capillary_number = 0.05;
-  c.level = 2;
-  c.t_end = 30.0;
-  c.viscosity_ratio = 10.0;
-  const CaseResult r = run(c, "jeffery_lambda_10");
-  ASSERT_EQ(r.status, "done") << r.reason;
-  EXPECT_EQ(r.analysis.regime, diagnostics::Regime::tumbling);
-  const double r_ab = 2.0;
-  EXPECT_NEAR(r.analysis.period, std::numbers::pi * (r_ab + 1.0 / r_ab), 0.05 * std::numbers::pi * (r_ab + 1.0 / r_ab));
+// A viscous interior and a stiff membrane (Ca = 0.05) on an a/b = 2 prolate spheroid: the capsule tumbles, and as λ
+// grows it turns as a rigid spheroid, whose shape (D12) repeats every half Jeffery period π(r + 1/r) = 7.854 for
+// r = 2 (the full rotation takes 2π(r + 1/r)). At finite λ the membrane still tank-treads a little, which slows the
+// tumbling (Keller & Skalak 1982: the period exceeds Jeffery's and decreases to it as λ → ∞): so at λ = 10 and 20 the
+// period lies above Jeffery's, within 10% of it, and is closer to it at λ = 20.
+TEST(ViscosityRatioSpheroid, LargeLambdaTumblesTowardsJefferysPeriod) {
+  const double jeffery = std::numbers::pi * (2.0 + 1.0 / 2.0);
+  double previous = 0.0;
+  for (const double lambda : {10.0, 20.0}) {
+    config::CaseConfig c;
+    c.aspect_ratio = 2.0;
+    c.law = "skalak";
+    c.capillary_number = 0.05;
+    c.level = 2;
+    c.t_end = 30.0;
+    c.viscosity_ratio = lambda;
+    const CaseResult r = run(c, "jeffery_lambda_" + std::to_string(lambda));
+    ASSERT_EQ(r.status, "done") << r.reason;
+    EXPECT_EQ(r.analysis.regime, diagnostics::Regime::tumbling) << "λ " << lambda;
+    EXPECT_GT(r.analysis.period, jeffery) << "λ " << lambda;
+    EXPECT_LT(r.analysis.period, 1.1 * jeffery) << "λ " << lambda;
+    if (previous > 0.0) EXPECT_LT(r.analysis.period, previous) << "closer to Jeffery's period as λ grows";
+    previous = r.analysis.period;
+  }
 }
 
 }  // namespace

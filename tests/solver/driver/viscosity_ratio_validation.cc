@@ -70,14 +70,15 @@ TEST(ViscosityRatioSphere, SmallDeformationLimitDoesNotDependOnLambda) {
   }
 }
 
-// A viscous interior and a stiff membrane (Ca = 0.05) on an a/b = 2 prolate spheroid: the capsule tumbles, and as λ
-// grows it turns as a rigid spheroid, whose shape (D12) repeats every half Jeffery period π(r + 1/r) = 7.854 for
-// r = 2 (the full rotation takes 2π(r + 1/r)). At finite λ the membrane still tank-treads a little, which slows the
-// tumbling (Keller & Skalak 1982: the period exceeds Jeffery's and decreases to it as λ → ∞): so at λ = 10 and 20 the
-// period lies above Jeffery's, within 10% of it, and is closer to it at λ = 20.
-TEST(ViscosityRatioSpheroid, LargeLambdaTumblesTowardsJefferysPeriod) {
+// A viscous interior and a stiff membrane (Ca = 0.05) on an a/b = 2 prolate spheroid: the capsule tumbles as a nearly
+// rigid spheroid, whose shape (D12) repeats every half Jeffery period π(r + 1/r) = 7.854 for r = 2 (the full
+// rotation takes 2π(r + 1/r)). Measured (level 2): 8.243 at λ = 10 and 8.241 at λ = 20, both 4.9% above Jeffery's and
+// not moving towards it between λ = 10 and 20, so the excess is not the residual tank-treading of a finite λ
+// (Keller & Skalak 1982); the finite Ca (D12 oscillates between 0.27 and 0.39) and the level-2 mesh are the
+// candidates, not yet separated (solver/README.md §3b, "Limits"). Asserted: tumbling, and the period within
+// [0.98, 1.1] × Jeffery's.
+TEST(ViscosityRatioSpheroid, LargeLambdaTumblesNearJefferysPeriod) {
   const double jeffery = std::numbers::pi * (2.0 + 1.0 / 2.0);
-  double previous = 0.0;
   for (const double lambda : {10.0, 20.0}) {
     config::CaseConfig c;
     c.aspect_ratio = 2.0;
@@ -89,10 +90,8 @@ TEST(ViscosityRatioSpheroid, LargeLambdaTumblesTowardsJefferysPeriod) {
     const CaseResult r = run(c, "jeffery_lambda_" + std::to_string(lambda));
     ASSERT_EQ(r.status, "done") << r.reason;
     EXPECT_EQ(r.analysis.regime, diagnostics::Regime::tumbling) << "λ " << lambda;
-    EXPECT_GT(r.analysis.period, jeffery) << "λ " << lambda;
+    EXPECT_GT(r.analysis.period, 0.98 * jeffery) << "λ " << lambda;
     EXPECT_LT(r.analysis.period, 1.1 * jeffery) << "λ " << lambda;
-    if (previous > 0.0) EXPECT_LT(r.analysis.period, previous) << "closer to Jeffery's period as λ grows";
-    previous = r.analysis.period;
   }
 }
 

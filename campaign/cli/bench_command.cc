@@ -104,6 +104,9 @@ int bench_flow(const BenchArgs& ba) {
                         {"singular_ms", s.singular_ms},
                         {"near_ms", s.near_ms},
                         {"volume_ms", s.volume_ms},
+                        {"second_kind_ms", s.second_kind_ms},
+                        {"gmres_iterations", s.gmres_iterations},
+                        {"evaluation_equal_viscosity_ms", s.evaluation_equal_viscosity_ms},
                         {"other_ms", s.other_ms}});
     // The symmetric scene's fields also at the top level: the scene of every run that starts in the shear plane.
     const auto& sym = r.scenes.front();

@@ -1,5 +1,6 @@
 #include "solver/driver/case_driver.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -11,6 +12,7 @@
 #include "solver/driver/snapshot_fields.h"
 #include "solver/dynamics/capsule_flow.h"
 #include "solver/dynamics/time_stepper.h"
+#include "solver/dynamics/viscosity_contrast.h"
 #include "solver/io/case_file.h"
 #include "solver/io/checkpoint.h"
 #include "solver/io/io_error.h"
@@ -131,6 +133,10 @@ class CaseRun {
       membrane_before_ = cp.scalars["membrane_s"];
       load_before_ = cp.scalars["load_s"];
       stokes_before_ = cp.scalars["stokes_s"];
+      // GMRES iterations of the viscosity-ratio solves before (written only when λ ≠ 1: 0 otherwise).
+      gmres_before_.solves = static_cast<long>(cp.scalars["gmres_solves"]);
+      gmres_before_.iterations = static_cast<long>(cp.scalars["gmres_iterations"]);
+      gmres_before_.max_iterations = static_cast<int>(cp.scalars["gmres_iterations_max"]);
       writer_.emplace(io::CaseWriter::resume(case_file_, case_attributes(config_), series_));
     } else {
       writer_.emplace(case_file_, case_attributes(config_));
@@ -197,6 +203,8 @@ class CaseRun {
     } catch (const membrane::DegenerateSurface& e) {
       failure = e.what();
     } catch (const dynamics::StepRejected& e) {  // dt too large for this state: a numerical outcome too
+      failure = e.what();
+    } catch (const dynamics::SecondKindNotConverged& e) {  // the viscosity-ratio solve failed: likewise
       failure = e.what();
     }
     if (stepped && (!std::isfinite(info.start.max_speed) || info.start.max_speed > kMaxDisturbanceSpeed)) {
@@ -298,6 +306,9 @@ class CaseRun {
     r_.membrane_s = membrane_s();
     r_.load_s = load_s();
     r_.stokes_s = stokes_s();
+    const dynamics::SecondKindStatistics gmres = gmres_statistics();
+    r_.gmres_iterations_mean = gmres.mean_iterations();
+    r_.gmres_iterations_max = gmres.max_iterations;
     r_.case_file = case_file_;
   }
 
@@ -327,6 +338,12 @@ class CaseRun {
     cp.scalars["membrane_s"] = membrane_s();
     cp.scalars["load_s"] = load_s();
     cp.scalars["stokes_s"] = stokes_s();
+    if (config_.viscosity_ratio != 1.0) {  // a λ = 1 checkpoint keeps its fields
+      const dynamics::SecondKindStatistics gmres = gmres_statistics();
+      cp.scalars["gmres_solves"] = static_cast<double>(gmres.solves);
+      cp.scalars["gmres_iterations"] = static_cast<double>(gmres.iterations);
+      cp.scalars["gmres_iterations_max"] = gmres.max_iterations;
+    }
     cp.strings["case"] = identity_;
     io::write_checkpoint(checkpoint_file_, cp);
   }
@@ -388,6 +405,15 @@ class CaseRun {
   long evaluations_before_ = 0;  // flow evaluations, wall and phase times of the invocations before a resume
   double wall_before_ = 0.0;
   double membrane_before_ = 0.0, load_before_ = 0.0, stokes_before_ = 0.0;
+  dynamics::SecondKindStatistics gmres_before_;
+  // The GMRES iterations of this and the earlier invocations.
+  [[nodiscard]] dynamics::SecondKindStatistics gmres_statistics() const {
+    dynamics::SecondKindStatistics g = flow_->second_kind_statistics();
+    g.solves += gmres_before_.solves;
+    g.iterations += gmres_before_.iterations;
+    g.max_iterations = std::max(g.max_iterations, gmres_before_.max_iterations);
+    return g;
+  }
   // The phase times of all invocations (membrane: elastic + bending), for the result and the checkpoint.
   [[nodiscard]] double membrane_s() const {
     return membrane_before_ + flow_->timings().membrane_s + flow_->timings().bending_s;

@@ -65,6 +65,10 @@ struct CaseResult {
   double t_final = 0;
   double wall_s = 0;
   double membrane_s = 0, load_s = 0, stokes_s = 0;  ///< wall time of the phases (membrane: elastic + bending)
+  /// GMRES iterations per flow evaluation of the viscosity-ratio solve (flow.viscosity_ratio ≠ 1), mean and
+  /// maximum over the case (all invocations); 0 at λ = 1.
+  double gmres_iterations_mean = 0;
+  int gmres_iterations_max = 0;
   std::filesystem::path case_file;
 };
 

@@ -65,6 +65,8 @@ const NumberField kNumberFields[] = {
     CAPSIM_SUMMARY_NUMBER(membrane_s, membrane_s),
     CAPSIM_SUMMARY_NUMBER(load_s, load_s),
     CAPSIM_SUMMARY_NUMBER(stokes_s, stokes_s),
+    CAPSIM_SUMMARY_NUMBER(gmres_iterations_mean, gmres_iterations_mean),
+    CAPSIM_SUMMARY_NUMBER(gmres_iterations_max, gmres_iterations_max),
 };
 #undef CAPSIM_SUMMARY_NUMBER
 
@@ -103,7 +105,7 @@ diagnostics::Regime regime_of(const std::string& name) {
 }  // namespace
 
 CaseParameters CaseParameters::of(const config::CaseConfig& c) {
-  return {c.capillary_number, c.aspect_ratio, c.law, c.skalak_C, c.level, c.bending_modulus};
+  return {c.capillary_number, c.aspect_ratio, c.law, c.skalak_C, c.level, c.bending_modulus, c.viscosity_ratio};
 }
 
 std::string parameter_mismatch(const CaseParameters& reported, const CaseParameters& expected) {
@@ -118,6 +120,8 @@ std::string parameter_mismatch(const CaseParameters& reported, const CaseParamet
   if (reported.mesh_level != expected.mesh_level) return "mesh_level " + std::to_string(reported.mesh_level);
   if (!near(reported.bending_modulus, expected.bending_modulus))
     return "bending_modulus " + text(reported.bending_modulus);
+  if (!near(reported.viscosity_ratio, expected.viscosity_ratio))
+    return "viscosity_ratio " + text(reported.viscosity_ratio);
   return "";
 }
 
@@ -140,6 +144,8 @@ CaseSummary CaseSummary::of(const config::CaseConfig& config, const CaseResult& 
   s.membrane_s = r.membrane_s;
   s.load_s = r.load_s;
   s.stokes_s = r.stokes_s;
+  s.gmres_iterations_mean = r.gmres_iterations_mean;
+  s.gmres_iterations_max = r.gmres_iterations_max;
   s.threads = omp_get_max_threads();
   s.case_file = r.case_file.empty() ? std::string() : std::filesystem::absolute(r.case_file).string();
   s.code_version = kGitCommit;
@@ -159,6 +165,7 @@ nlohmann::json CaseSummary::to_json() const {
       {"skalak_C", parameters.skalak_C},
       {"mesh_level", parameters.mesh_level},
       {"bending_modulus", parameters.bending_modulus},
+      {"viscosity_ratio", parameters.viscosity_ratio},
       {"regime", std::string(diagnostics::to_string(analysis.regime))},
       {"converged", converged},
       {"steps", steps},
@@ -195,6 +202,10 @@ CaseSummary CaseSummary::from_json(const nlohmann::json& j) {
     if (!kb->is_number()) throw std::invalid_argument("result: 'bending_modulus' is not a number");
     s.parameters.bending_modulus = kb->get<double>();
   }
+  if (const auto vr = j.find("viscosity_ratio"); vr != j.end()) {  // absent in results from before the key: 1
+    if (!vr->is_number()) throw std::invalid_argument("result: 'viscosity_ratio' is not a number");
+    s.parameters.viscosity_ratio = vr->get<double>();
+  }
   s.analysis.regime = regime_of(string_or_empty(j, "regime"));
   const auto converged = j.find("converged");
   s.converged = converged != j.end() && converged->is_boolean() && converged->get<bool>();
@@ -220,6 +231,7 @@ std::vector<io::Attribute> summary_attributes(const CaseSummary& s) {
   a.emplace_back("skalak_C", s.parameters.skalak_C);
   a.emplace_back("mesh_level", s.parameters.mesh_level);
   a.emplace_back("bending_modulus", s.parameters.bending_modulus);
+  a.emplace_back("viscosity_ratio", s.parameters.viscosity_ratio);
   a.emplace_back("regime", std::string(diagnostics::to_string(s.analysis.regime)));
   a.emplace_back("converged", s.converged ? 1 : 0);
   a.emplace_back("steps", s.steps);

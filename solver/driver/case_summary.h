@@ -32,6 +32,7 @@ struct CaseParameters {
   double skalak_C = 0;  ///< enters the case only for the Skalak law
   int mesh_level = 0;
   double bending_modulus = 0;  ///< κ_b (JSON "bending_modulus"; a result from before the key reads as 0)
+  double viscosity_ratio = 1;  ///< λ (JSON "viscosity_ratio"; a result from before the key reads as 1)
 
   /// @brief The parameters of a resolved case configuration.
   static CaseParameters of(const config::CaseConfig& config);
@@ -55,6 +56,7 @@ struct CaseSummary {
   long flow_evaluations = 0;
   double dt = 0, t_final = 0, wall_s = 0;
   double membrane_s = 0, load_s = 0, stokes_s = 0;  ///< wall time of the phases (CaseResult)
+  double gmres_iterations_mean = 0, gmres_iterations_max = 0;  ///< viscosity-ratio solve (CaseResult; 0 at λ = 1)
   int threads = 0;
   std::string case_file;  ///< absolute path of case.h5
   std::string code_version;    ///< git commit of the build

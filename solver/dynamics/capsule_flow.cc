@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "solver/dynamics/time_stepper.h"
+#include "solver/dynamics/viscosity_contrast.h"
 
 
 namespace capsim::dynamics {
@@ -15,7 +16,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 }  // namespace
 
-CapsuleFlow::CapsuleFlow(const config::CaseConfig& c) : Ca_(c.capillary_number) {
+CapsuleFlow::CapsuleFlow(const config::CaseConfig& c) : Ca_(c.capillary_number), viscosity_ratio_(c.viscosity_ratio) {
   c.validate();
   mesh_ = std::make_unique<mesh::SurfaceMesh>(
       mesh::make_capsule_mesh(c.level, c.aspect_ratio, mesh::parse_spheroid_map(c.spheroid_map)));
@@ -38,6 +39,11 @@ CapsuleFlow::CapsuleFlow(const config::CaseConfig& c) : Ca_(c.capillary_number) 
   so.precision = c.kernel_precision == "mixed" ? stokes::KernelPrecision::Mixed : stokes::KernelPrecision::Double;
   so.central_symmetry = c.central_symmetry;
   single_layer_ = std::make_unique<stokes::SingleLayer>(*mesh_, so);
+  if (c.viscosity_ratio != 1.0) {  // λ = 1: no second-kind solve, v = f (the path of every committed result)
+    stokes::SecondKindOptions ko;
+    ko.tolerance = c.viscosity_tolerance;
+    second_kind_ = std::make_unique<ViscosityContrast>(*mesh_, single_layer_->options(), c.viscosity_ratio, ko);
+  }
   volume_correction_ = c.volume_correction;
   flux_rule_ = mesh::P2Tabulation::of_degree(6);
 }
@@ -209,7 +215,8 @@ double stable_time_step(double h_min, double capillary_number, double factor) {
 
 /// The spectral radius RKC chooses its stages for on the reference shape (no prestress), safety included.
 double reference_spectral_radius(const config::CaseConfig& config, double h_min) {
-  return config.rkc_safety * membrane_spectral_radius(h_min, config.capillary_number, 0.0, config.bending_modulus);
+  return config.rkc_safety * membrane_spectral_radius(h_min, config.capillary_number, 0.0, config.bending_modulus,
+                                                      config.viscosity_ratio);
 }
 }  // namespace
 
@@ -222,7 +229,9 @@ double automatic_time_step(const config::CaseConfig& config, const mesh::Surface
 }
 
 double automatic_time_step(const config::CaseConfig& config, double h_min) {
-  double stable = stable_time_step(h_min, config.capillary_number, config.dt_factor);
+  // A viscosity ratio scales the stiffness (viscosity_stiffness_factor; exactly 1 at λ = 1).
+  double stable = stable_time_step(h_min, config.capillary_number, config.dt_factor) /
+                  viscosity_stiffness_factor(config.viscosity_ratio);
   if (config.bending_modulus <= 0.0) return config.scheme == config::TimeScheme::Rkc ? std::max(config.dt_accuracy, stable) : stable;
   stable /= 1.0 + bending_stiffness_ratio(config.bending_modulus, h_min);
   if (config.scheme != config::TimeScheme::Rkc) return stable;

@@ -60,6 +60,17 @@ struct FlowTimings {
   long evaluations = 0;      ///< calls of CapsuleFlow::velocity (the phases called alone do not count)
 };
 
+/// @brief Iteration counts of the second-kind solves of a CapsuleFlow since its construction (all zero at λ = 1).
+struct SecondKindStatistics {
+  long solves = 0;         ///< converged solves (one per boundary_velocity)
+  long iterations = 0;     ///< Krylov iterations summed over them
+  int max_iterations = 0;  ///< the largest count of one solve
+  /// @brief Mean iterations per solve (0 without solves).
+  [[nodiscard]] double mean_iterations() const {
+    return solves > 0 ? static_cast<double>(iterations) / static_cast<double>(solves) : 0.0;
+  }
+};
+
 /// @brief The second-kind boundary integral equation of a viscosity contrast λ ≠ 1 (inner/outer viscosity),
 /// the place where the interior fluid enters CapsuleFlow::boundary_velocity. With f = v∞ − S[q]/(8π Ca) the
 /// surface velocity of equal viscosities (the single layer of the load), the velocity v of the contrast solves
@@ -84,6 +95,8 @@ class SecondKindSolve {
   virtual void solve(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& f, Eigen::Matrix3Xd& v) = 0;
   /// @brief A time step begins (CapsuleFlow::begin_step): drop every warm start.
   virtual void begin_step() {}
+  /// @brief Iterations of the solves so far (an implementation without iterations keeps the zeros).
+  [[nodiscard]] virtual SecondKindStatistics statistics() const { return {}; }
 };
 
 /// @brief Mesh, law, membrane, load solver and boundary-integral operator of one case, built once.
@@ -137,8 +150,15 @@ class CapsuleFlow {
   /// @throws whatever the SecondKindSolve throws when it does not converge (never without one).
   FlowEvaluation boundary_velocity(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& q, Eigen::Matrix3Xd& v);
 
-  /// @brief Install the second-kind solve of a viscosity contrast (nullptr: none, λ = 1, the default).
+  /// @brief Install the second-kind solve of a viscosity contrast (nullptr: none, λ = 1). The constructor
+  /// installs a ViscosityContrast (viscosity_contrast.h) when flow.viscosity_ratio ≠ 1.
   void set_second_kind_solve(std::unique_ptr<SecondKindSolve> solve);
+  /// @brief Iterations of the installed second-kind solve (zeros without one).
+  [[nodiscard]] SecondKindStatistics second_kind_statistics() const {
+    return second_kind_ ? second_kind_->statistics() : SecondKindStatistics{};
+  }
+  /// @brief λ = flow.viscosity_ratio of the case.
+  [[nodiscard]] double viscosity_ratio() const { return viscosity_ratio_; }
 
   /// @brief Bending energy and largest moment of the last membrane_load / bending_load / velocity (zero without
   /// bending).
@@ -180,6 +200,7 @@ class CapsuleFlow {
   membrane::MembraneState membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q, bool warm);
 
   double Ca_;
+  double viscosity_ratio_ = 1.0;
   std::unique_ptr<mesh::SurfaceMesh> mesh_;
   std::unique_ptr<membrane::MembraneLaw> law_;
   std::unique_ptr<membrane::MembraneMechanics> mechanics_;

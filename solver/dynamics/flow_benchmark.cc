@@ -51,9 +51,10 @@ Eigen::Matrix3Xd deformed_centrally_symmetric(const Eigen::Matrix3Xd& ref) {
   return x;
 }
 
-// `in_double`: the same case in double precision, timed alternately too (nullptr: the evaluation is double).
-FlowBenchScene measure_scene(CapsuleFlow& flow, CapsuleFlow* in_double, const Eigen::Matrix3Xd& x,
-                             const std::string& name, int repeat) {
+// `in_double`: the same case in double precision, timed alternately too (nullptr: the evaluation is double);
+// `equal_viscosity`: the same case at λ = 1, likewise (nullptr: λ = 1 already).
+FlowBenchScene measure_scene(CapsuleFlow& flow, CapsuleFlow* in_double, CapsuleFlow* equal_viscosity,
+                             const Eigen::Matrix3Xd& x, const std::string& name, int repeat) {
   FlowBenchScene sc;
   sc.name = name;
   sc.nodes = static_cast<int>(x.cols());
@@ -89,18 +90,26 @@ FlowBenchScene measure_scene(CapsuleFlow& flow, CapsuleFlow* in_double, const Ei
   stokes::kernel::sum_fast(tg, src.sources(), res, fast);  // warm-up
 
   // Alternate evaluation and bare sum, so that both see the same machine state.
-  std::vector<double> eval_ms, bare_ms, double_ms;
+  std::vector<double> eval_ms, bare_ms, double_ms, equal_ms;
   Eigen::Matrix3Xd vd;
   if (in_double) in_double->velocity(x, vd);  // warm-up
+  if (equal_viscosity) equal_viscosity->velocity(x, vd);
   const FlowTimings before = flow.timings();
+  const SecondKindStatistics gmres_before = flow.second_kind_statistics();
   for (int r = 0; r < repeat; ++r) {
     double t0 = now_ms();
+    flow.begin_step();  // no warm start from the previous (identical) evaluation
     flow.velocity(x, v);
     eval_ms.push_back(now_ms() - t0);
     if (in_double) {
       t0 = now_ms();
       in_double->velocity(x, vd);
       double_ms.push_back(now_ms() - t0);
+    }
+    if (equal_viscosity) {
+      t0 = now_ms();
+      equal_viscosity->velocity(x, vd);
+      equal_ms.push_back(now_ms() - t0);
     }
     t0 = now_ms();
     stokes::kernel::sum_fast(tg, src.sources(), res, fast);
@@ -110,6 +119,8 @@ FlowBenchScene measure_scene(CapsuleFlow& flow, CapsuleFlow* in_double, const Ei
   sc.repeat = repeat;
   sc.evaluation_ms = median(eval_ms);
   if (in_double) sc.evaluation_double_ms = median(double_ms);
+  if (equal_viscosity) sc.evaluation_equal_viscosity_ms = median(equal_ms);
+  sc.gmres_iterations = static_cast<double>(flow.second_kind_statistics().iterations - gmres_before.iterations) / repeat;
   sc.regular_sum_ms = median(bare_ms);
   sc.overhead_ratio = sc.evaluation_ms / sc.regular_sum_ms;
   const double per = 1e3 / repeat;
@@ -122,10 +133,11 @@ FlowBenchScene measure_scene(CapsuleFlow& flow, CapsuleFlow* in_double, const Ei
   sc.singular_ms = per * (after.singular_s - before.singular_s);
   sc.near_ms = per * (after.near_s - before.near_s);
   sc.volume_ms = per * (after.volume_s - before.volume_s);
+  sc.second_kind_ms = per * (after.second_kind_s - before.second_kind_s);
   double mean_eval = 0.0;
   for (double t : eval_ms) mean_eval += t / repeat;
   sc.other_ms = mean_eval - (sc.membrane_ms + sc.bending_ms + sc.load_ms + sc.layout_ms + sc.regular_ms + sc.far_ms +
-                             sc.singular_ms + sc.near_ms + sc.volume_ms);
+                             sc.singular_ms + sc.near_ms + sc.volume_ms + sc.second_kind_ms);
   return sc;
 }
 
@@ -165,6 +177,12 @@ FlowBenchReport bench_flow(const FlowBenchOptions& options) {
     cd.kernel_precision = "double";
     in_double = std::make_unique<CapsuleFlow>(cd);
   }
+  std::unique_ptr<CapsuleFlow> equal_viscosity;
+  if (c.viscosity_ratio != 1.0) {
+    config::CaseConfig ce = c;
+    ce.viscosity_ratio = 1.0;
+    equal_viscosity = std::make_unique<CapsuleFlow>(ce);
+  }
   FlowBenchReport report;
   report.level = c.level;
   report.threads = omp_get_max_threads();
@@ -173,19 +191,25 @@ FlowBenchReport bench_flow(const FlowBenchOptions& options) {
   const int repeat =
       options.repeat > 0 ? options.repeat : std::clamp(static_cast<int>(40.0 * std::pow(4.0, 3 - c.level)), 5, 400);
   for (const bool symmetric : {true, false})
-    report.scenes.push_back(measure_scene(flow, in_double.get(), deformed(flow.reference(), symmetric),
-                                          symmetric ? "symmetric" : "general", repeat));
+    report.scenes.push_back(measure_scene(flow, in_double.get(), equal_viscosity.get(),
+                                          deformed(flow.reference(), symmetric), symmetric ? "symmetric" : "general",
+                                          repeat));
   // The same capsule with numerics.central_symmetry, on a scene that has both symmetries.
   config::CaseConfig cc = c;
   cc.central_symmetry = true;
   CapsuleFlow central(cc);
-  std::unique_ptr<CapsuleFlow> central_double;
+  std::unique_ptr<CapsuleFlow> central_double, central_equal;
+  if (equal_viscosity) {
+    config::CaseConfig ce = cc;
+    ce.viscosity_ratio = 1.0;
+    central_equal = std::make_unique<CapsuleFlow>(ce);
+  }
   if (in_double) {
     cc.kernel_precision = "double";
     central_double = std::make_unique<CapsuleFlow>(cc);
   }
-  report.scenes.push_back(measure_scene(central, central_double.get(), deformed_centrally_symmetric(central.reference()),
-                                        "central", repeat));
+  report.scenes.push_back(measure_scene(central, central_double.get(), central_equal.get(),
+                                        deformed_centrally_symmetric(central.reference()), "central", repeat));
   return report;
 }
 

@@ -28,7 +28,8 @@ struct FlowBenchOptions {
   /// @brief The measured capsule as a case: by default the a/b = 2 Skalak capsule at Ca = 0.3 on mesh level 3
   /// in double precision; any case key may change it (scene_with). With numerics.kernel_precision "mixed" the
   /// same scene is also evaluated in double, alternately in the same run (FlowBenchScene::evaluation_double_ms):
-  /// the speed-up.
+  /// the speed-up. With flow.viscosity_ratio ≠ 1 the scene is also evaluated at λ = 1, alternately in the same
+  /// run (FlowBenchScene::evaluation_equal_viscosity_ms).
   config::CaseConfig scene = scene_with({});
   int repeat = 0;  ///< timed evaluations per scene; 0 = automatic (about a second per scene, 5..400)
   /// @brief Whether the options are usable; if not and why is not null, *why says which and why (the case
@@ -63,6 +64,11 @@ struct FlowBenchScene {
   double singular_ms = 0.0;     ///< Duffy correction
   double near_ms = 0.0;         ///< near-singular correction and mirror
   double volume_ms = 0.0;       ///< velocity assembly, node normals, flux, volume correction
+  double second_kind_ms = 0.0;  ///< the viscosity-ratio solve (0 at λ = 1)
+  /// Mean GMRES iterations per evaluation of the viscosity-ratio solve (0 at λ = 1). Every timed evaluation starts
+  /// a step (CapsuleFlow::begin_step): a cold solve, the first stage of a step, the dearest.
+  double gmres_iterations = 0.0;
+  double evaluation_equal_viscosity_ms = 0.0;  ///< the same scene at λ = 1, alternated (0 when λ = 1 already)
   double other_ms = 0.0;        ///< mean evaluation time not in a named phase (timers, copies)
 };
 

@@ -86,7 +86,8 @@ StepInfo RkcIntegrator::step(CapsuleFlow& flow, Eigen::Matrix3Xd& x, double dt, 
   info.start = flow.velocity(x, f0_, start ? &start->load : nullptr);
   if (start) start->velocity = f0_;
   const double rho = options_.safety * membrane_spectral_radius(flow.mesh(), x, flow.capillary_number(),
-                                                                info.start.tau_max, flow.bending_modulus());
+                                                                info.start.tau_max, flow.bending_modulus(),
+                                                                flow.viscosity_ratio());
   last_rho_ = rho;
   const int s = stages_for(dt * rho, options_.damping);
   if (s > options_.max_stages)
@@ -135,8 +136,9 @@ std::unique_ptr<TimeIntegrator> make_integrator(config::TimeScheme scheme, doubl
 }
 
 double membrane_spectral_radius(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x, double capillary_number,
-                                double tau_max, double bending_modulus) {
-  return membrane_spectral_radius(mesh::min_node_spacing(mesh, x), capillary_number, tau_max, bending_modulus);
+                                double tau_max, double bending_modulus, double viscosity_ratio) {
+  return membrane_spectral_radius(mesh::min_node_spacing(mesh, x), capillary_number, tau_max, bending_modulus,
+                                  viscosity_ratio);
 }
 
 double estimate_spectral_radius(CapsuleFlow& flow, const Eigen::Matrix3Xd& x, int iterations) {

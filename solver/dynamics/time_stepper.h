@@ -155,19 +155,36 @@ std::unique_ptr<TimeIntegrator> make_integrator(config::TimeScheme scheme, doubl
 /// ∝ κ_b/(Ca h³) (the load ∝ κ_b k⁴ against the Stokes mobility ∝ 1/k); the estimate adds
 ///   kBendingSpectralConstant · κ_b / (Ca · h_min(x)³),
 /// calibrated by power iteration the same way (tests/solver/dynamics/spectral_radius_validation.cc).
+///
+/// With a viscosity ratio λ (flow.viscosity_ratio) the whole estimate is multiplied by
+/// viscosity_stiffness_factor(λ) (below).
 double membrane_spectral_radius(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x, double capillary_number,
-                                double tau_max, double bending_modulus = 0.0);
+                                double tau_max, double bending_modulus = 0.0, double viscosity_ratio = 1.0);
 inline constexpr double kSpectralRadiusConstant = 6.5;
 inline constexpr double kPrestressCoefficient = 0.4;
 inline constexpr double kBendingSpectralConstant = 45.0;
 
+/// @brief How a viscosity ratio λ scales the membrane's stiffness: 2/(1 + λ) (exactly 1 at λ = 1).
+///
+/// Why: the fastest modes have the shortest wavelengths, on which the surface is locally flat; there the
+/// double layer's principal value vanishes (T·n = 0 for r in the tangent plane) and the second-kind equation
+/// reduces to (1 + λ)/2 · v = f: both fluids resist the membrane, and its relaxation rates are those of λ = 1
+/// times 2/(1 + λ). Measured by power iteration on dv/dx (estimate_spectral_radius) at the reference
+/// spheroids a/b = 0.5, 1, 2, level 2, Ca = 0.05 (results/validation/README.md, "Viscosity ratio", "Stiffness"):
+/// ρ(λ)/ρ(1) = 1.77–1.79 at λ = 0.1 (2/(1 + λ) = 1.82) and 0.185–0.188 at λ = 10 (0.182), and the scaled
+/// estimate keeps a margin of 1.24–1.41 over the power iteration (1.26–1.37 at λ = 1). The automatic rk2 dt is
+/// divided by it and the RKC stages follow it (membrane_spectral_radius), so at λ = 10 a step costs the stages
+/// of a membrane 5.5 times softer and at λ = 0.1 of one 1.8 times stiffer.
+inline double viscosity_stiffness_factor(double viscosity_ratio) { return 2.0 / (1.0 + viscosity_ratio); }
+
 /// @brief The estimate above for a smallest node spacing @p h_min: the one formula, which the mesh form
 /// evaluates at h_min(x) and the campaign's cost estimate at the reference mesh's h_min.
 inline double membrane_spectral_radius(double h_min, double capillary_number, double tau_max,
-                                       double bending_modulus = 0.0) {
-  return kSpectralRadiusConstant * (1.0 + kPrestressCoefficient * (tau_max > 0.0 ? tau_max : 0.0)) /
-             (capillary_number * h_min) +
-         kBendingSpectralConstant * bending_modulus / (capillary_number * h_min * h_min * h_min);
+                                       double bending_modulus = 0.0, double viscosity_ratio = 1.0) {
+  return viscosity_stiffness_factor(viscosity_ratio) *
+         (kSpectralRadiusConstant * (1.0 + kPrestressCoefficient * (tau_max > 0.0 ? tau_max : 0.0)) /
+              (capillary_number * h_min) +
+          kBendingSpectralConstant * bending_modulus / (capillary_number * h_min * h_min * h_min));
 }
 
 /// @brief ρ_bending / ρ_elastic of the estimate above at node spacing h without prestress:

@@ -132,6 +132,10 @@ TEST(Identity, StableAndSensitiveToWhatMatters) {
   EXPECT_EQ(explicit_default.canonical().find("bending"), std::string::npos);
   explicit_default.set("numerics.kernel_precision", std::string("double"));  // so is numerics.kernel_precision
   EXPECT_EQ(explicit_default.identity("abc"), p.identity("abc"));
+  explicit_default.set("flow.viscosity_ratio", 1.0);  // and the viscosity ratio with its solve's tolerance
+  explicit_default.set("numerics.viscosity_tolerance", 1e-8);
+  EXPECT_EQ(explicit_default.identity("abc"), p.identity("abc"));
+  EXPECT_EQ(explicit_default.canonical().find("viscosity"), std::string::npos);
   // Changes that matter.
   for (auto [k, v] : std::vector<std::pair<std::string, Value>>{{"flow.capillary_number", 0.31},
                                                                 {"capsule.aspect_ratio", 0.5},
@@ -144,6 +148,7 @@ TEST(Identity, StableAndSensitiveToWhatMatters) {
                                                                 {"time.scheme", std::string("rk2")},
                                                                 {"numerics.regular_degree", std::int64_t{6}},
                                                                 {"capsule.bending_modulus", 1e-3},
+                                                                {"flow.viscosity_ratio", 5.0},
                                                                 {"numerics.kernel_precision", std::string("mixed")}}) {
     CaseParams q = p;
     q.set(k, v);

@@ -1,4 +1,5 @@
-// Case configuration: the far-field keys of the boundary integral and the bending modulus (parsing, ranges, echo).
+// Case configuration: the far-field keys of the boundary integral, the bending modulus and the viscosity ratio
+// (parsing, ranges).
 #include "solver/config/case_config.h"
 
 #include <algorithm>
@@ -86,6 +87,24 @@ TEST(CaseConfig, BendingModulusDefaultsToNoneAndIsRangeChecked) {
       ADD_FAILURE() << bad << " accepted";
     } catch (const ConfigError& e) {
       EXPECT_NE(std::string(e.what()).find("capsule.bending_modulus"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(CaseConfig, ViscosityRatioDefaultsToOneAndIsRangeChecked) {
+  EXPECT_EQ(parse_case_config("", "empty").viscosity_ratio, 1.0);
+  EXPECT_EQ(parse_case_config("[flow]\nviscosity_ratio = 5\n", "case.toml").viscosity_ratio, 5.0);
+  EXPECT_EQ(parse_case_config("", "case.toml", {"flow.viscosity_ratio=0.05"}).viscosity_ratio, 0.05);
+  EXPECT_EQ(parse_case_config("", "case.toml", {"flow.viscosity_ratio=20"}).viscosity_ratio, 20.0);
+  for (const char* bad : {"flow.viscosity_ratio=0.04", "flow.viscosity_ratio=21", "flow.viscosity_ratio=0",
+                          "flow.viscosity_ratio=-1", "flow.viscosity_ratio=nan", "flow.viscosity_ratio=\"five\"",
+                          "numerics.viscosity_tolerance=0", "numerics.viscosity_tolerance=0.1"}) {
+    try {
+      (void)parse_case_config("", "case.toml", {bad});
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const ConfigError& e) {
+      const std::string key = std::string(bad).substr(0, std::string(bad).find('='));
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
     }
   }
 }

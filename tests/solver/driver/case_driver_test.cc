@@ -9,7 +9,9 @@
 #include <numbers>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
+#include "solver/driver/case_summary.h"
 #include "solver/io/case_file.h"
 #include "solver/io/checkpoint.h"
 #include "solver/io/io_error.h"
@@ -397,6 +399,39 @@ TEST(CaseDriver, WarmStartedLoadSolvesResumeBitwise) {
 // bitwise: its checkpoint holds the symmetrised state, from which the driver decides the same way.
 TEST(CaseDriver, CentralSymmetryGivesTheSameCaseAndResumesBitwise) {
   expect_option_keeps_the_case("skalak", [](config::CaseConfig& c) { c.central_symmetry = true; }, "central", 1e-11);
+}
+
+// flow.viscosity_ratio: the second-kind solve's warm start never crosses a step (CapsuleFlow::begin_step), so a run
+// interrupted halfway resumes bitwise, and its GMRES statistics, carried by the checkpoint, are those of the
+// uninterrupted run; the summary reports them.
+TEST(CaseDriver, ViscosityRatioRunResumesBitwiseWithItsIterationCounts) {
+  config::CaseConfig c;
+  c.aspect_ratio = 0.5;
+  c.law = config::MembraneLawKind::Skalak;
+  c.capillary_number = 0.05;
+  c.level = 2;
+  c.t_end = 0.3;
+  c.viscosity_ratio = 5.0;
+  const auto dir = scratch("viscosity_full");
+  const CaseResult full = run_case(c, quiet_in(dir));
+  ASSERT_EQ(full.status, "done") << full.reason;
+  EXPECT_GT(full.gmres_iterations_mean, 0.0);
+  EXPECT_GE(full.gmres_iterations_max, full.gmres_iterations_mean);
+  const CaseSummary summary = CaseSummary::of(c, full);
+  EXPECT_EQ(summary.to_json().at("viscosity_ratio").get<double>(), 5.0);
+  EXPECT_EQ(summary.to_json().at("gmres_iterations_mean").get<double>(), full.gmres_iterations_mean);
+  const auto rdir = scratch("viscosity_resumed");
+  RunOptions o = quiet_in(rdir);
+  o.stop_after_steps = full.steps / 2 + 1;
+  ASSERT_EQ(run_case(c, o).status, "interrupted");
+  o.stop_after_steps = 0;
+  o.resume = true;
+  const CaseResult resumed = run_case(c, o);
+  EXPECT_EQ(resumed.steps, full.steps);
+  EXPECT_EQ(resumed.flow_evaluations, full.flow_evaluations);
+  EXPECT_EQ(resumed.gmres_iterations_mean, full.gmres_iterations_mean);
+  EXPECT_EQ(resumed.gmres_iterations_max, full.gmres_iterations_max);
+  EXPECT_TRUE(io::read_case_file(rdir / "case.h5").series == io::read_case_file(dir / "case.h5").series);
 }
 
 }  // namespace

@@ -102,5 +102,43 @@ TEST_P(BendingSpectralRadius, EstimateBoundsThePowerIteration) {
 INSTANTIATE_TEST_SUITE_P(Bending, BendingSpectralRadius,
                          testing::Combine(testing::Values(1e-3, 1e-2, 1e-1), testing::Values(2, 3, 4)));
 
+// Viscosity ratio: the power-iteration ρ at λ = 0.1 and 10 against λ = 1 on the same state (level 2, the
+// 5%-stretched reference spheroids a/b = 0.5, 1, 2, Ca = 0.05, GMRES to 1e-12 so that the finite differences
+// of v are not noise), against viscosity_stiffness_factor(λ) = 2/(1 + λ). Prints one row per case
+// (results/validation/README.md, "Viscosity ratio: stiffness", quotes them) and asserts that the scaled
+// estimate still bounds the truth and that the measured ratio is the factor to within 15%.
+TEST(ViscositySpectralRadius, ScalesLikeTwoOverOnePlusLambda) {
+  for (double r : {0.5, 1.0, 2.0}) {
+    double rho1 = 0.0;
+    for (double lambda : {1.0, 0.1, 10.0}) {
+      config::CaseConfig cfg;
+      cfg.law = config::MembraneLawKind::Skalak;
+      cfg.aspect_ratio = r;
+      cfg.capillary_number = 0.05;
+      cfg.level = 2;
+      cfg.viscosity_ratio = lambda;
+      cfg.viscosity_tolerance = 1e-12;
+      CapsuleFlow flow(cfg);
+      Eigen::Matrix3Xd x = flow.reference();
+      x.row(0) *= 1.05;
+      x.row(1) /= std::sqrt(1.05);
+      x.row(2) /= std::sqrt(1.05);
+      Eigen::Matrix3Xd v;
+      const FlowEvaluation ev = flow.velocity(x, v);
+      const double truth = estimate_spectral_radius(flow, x, 100);
+      if (lambda == 1.0) rho1 = truth;
+      const double estimate = membrane_spectral_radius(flow.mesh(), x, cfg.capillary_number, ev.tau_max, 0.0, lambda);
+      const double ratio = truth / rho1;
+      std::printf("| viscosity | a/b %.1f | λ %.1f | ρ %.4g | ρ/ρ(λ=1) %.3f | 2/(1+λ) %.3f | estimate/ρ %.3f | "
+                  "GMRES mean %.1f max %d |\n",
+                  r, lambda, truth, ratio, viscosity_stiffness_factor(lambda), estimate / truth,
+                  flow.second_kind_statistics().mean_iterations(), flow.second_kind_statistics().max_iterations);
+      EXPECT_GT(estimate, truth) << "a/b " << r << " λ " << lambda;
+      EXPECT_NEAR(ratio, viscosity_stiffness_factor(lambda), 0.15 * viscosity_stiffness_factor(lambda))
+          << "a/b " << r << " λ " << lambda;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace capsim::dynamics

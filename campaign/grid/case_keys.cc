@@ -30,6 +30,7 @@ const std::vector<std::pair<std::string, std::string>>& axis_aliases() {
       {"skalak_C", "capsule.skalak_C"},
       {"mesh_level", "mesh.level"},
       {"bending_modulus", "capsule.bending_modulus"},
+      {"viscosity_ratio", "flow.viscosity_ratio"},
   };
   return aliases;
 }

@@ -191,23 +191,37 @@ TEST(Grid, CasesTheSolverRejectsAreBadInput) {
 }
 
 // The bending modulus is a grid axis like the others (alias bending_modulus); 0 is the same case as unset.
-TEST(Grid, BendingModulusIsAnAxis) {
-  const auto spec = parse_campaign("[campaign]\nname='b'\n[defaults]\nflow.capillary_number=0.05\n"
-                                   "[[grid]]\nbending_modulus=[0, 1e-3, 1e-2]\n",
-                                   "b.toml");
-  const auto cases = expand_grid(spec);
-  ASSERT_EQ(cases.size(), 3u);
-  CaseParams unset = CaseParams::defaults();
-  unset.set("flow.capillary_number", 0.05);
-  EXPECT_EQ(cases[0].identity("v"), unset.identity("v"));
-  EXPECT_NE(cases[1].identity("v"), cases[0].identity("v"));
-  EXPECT_NE(cases[2].identity("v"), cases[1].identity("v"));
-  EXPECT_NE(cases[2].to_toml().find("bending_modulus = 0.01"), std::string::npos) << cases[2].to_toml();
-  try {
-    (void)parse_campaign("[campaign]\nname='b'\n[[grid]]\nbending_modulus=[-1]\n", "b.toml");
-    ADD_FAILURE() << "a negative bending modulus was accepted";
-  } catch (const BadInput& e) {
-    EXPECT_NE(std::string(e.what()).find("bending_modulus"), std::string::npos) << e.what();
+// The physical axes beyond the seed's: the first value is the key's default (that case keeps the identity it has
+// without the axis), the others give new cases; a value outside the key's range is bad input naming the axis.
+struct PhysicalAxis {
+  const char* axis;
+  const char* values;        // the grid's list, default first
+  const char* toml_of_last;  // what the last case's case file says
+  const char* out_of_range;
+};
+
+TEST(Grid, BendingModulusAndViscosityRatioAreAxes) {
+  for (const PhysicalAxis& a : {PhysicalAxis{"bending_modulus", "[0, 1e-3, 1e-2]", "bending_modulus = 0.01", "[-1]"},
+                                PhysicalAxis{"viscosity_ratio", "[1, 0.2, 5]", "viscosity_ratio = 5", "[25]"}}) {
+    SCOPED_TRACE(a.axis);
+    const auto spec = parse_campaign(std::string("[campaign]\nname='b'\n[defaults]\nflow.capillary_number=0.05\n"
+                                                 "[[grid]]\n") + a.axis + "=" + a.values + "\n",
+                                     "b.toml");
+    const auto cases = expand_grid(spec);
+    ASSERT_EQ(cases.size(), 3u);
+    CaseParams unset = CaseParams::defaults();
+    unset.set("flow.capillary_number", 0.05);
+    EXPECT_EQ(cases[0].identity("v"), unset.identity("v"));
+    EXPECT_NE(cases[1].identity("v"), cases[0].identity("v"));
+    EXPECT_NE(cases[2].identity("v"), cases[1].identity("v"));
+    EXPECT_NE(cases[2].to_toml().find(a.toml_of_last), std::string::npos) << cases[2].to_toml();
+    try {
+      (void)parse_campaign(std::string("[campaign]\nname='b'\n[[grid]]\n") + a.axis + "=" + a.out_of_range + "\n",
+                           "b.toml");
+      ADD_FAILURE() << "an out-of-range " << a.axis << " was accepted";
+    } catch (const BadInput& e) {
+      EXPECT_NE(std::string(e.what()).find(a.axis), std::string::npos) << e.what();
+    }
   }
 }
 

@@ -228,7 +228,9 @@ TEST(MultiFidelity, ACellTakesItsNextRoundWhileAnotherCellsCasesRun) {
   ASSERT_EQ(sql(dir + "/plain.db", "SELECT COUNT(*) FROM transitions WHERE role = 'dt_check' AND aspect_ratio = 2"),
             "1\n") << "the prolate cell has its dt check: " << r.err;
 
-  r = sh(campaign_cmd(env + " FAKE_SLOW_CA=0.8 FAKE_SLOW_LEVEL=1 FAKE_SLOW_STEP_S=4", dir + "/mf.toml",
+  // The oblate scan case lasts 10 s: long enough for the other worker to finish several prolate cases even when
+  // ctest runs other suites beside this one (4 s was not, at a load average of 2 to 17).
+  r = sh(campaign_cmd(env + " FAKE_SLOW_CA=0.8 FAKE_SLOW_LEVEL=1 FAKE_SLOW_STEP_S=10", dir + "/mf.toml",
                       dir + "/slow.db", "--jobs 2"));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("dt/2 check on level 2, while "), std::string::npos) << r.err;

@@ -165,7 +165,7 @@ FlowEvaluation CapsuleFlow::boundary_velocity(const Eigen::Matrix3Xd& x, const E
   // With a viscosity contrast this is f, the right-hand side of the second-kind solve, and v its solution.
   Eigen::Matrix3Xd& f = second_kind_ ? f_ : v;
   f = factor * u_;
-  out.max_speed = f.colwise().norm().maxCoeff();
+  if (!second_kind_) out.max_speed = f.colwise().norm().maxCoeff();  // with one: of the solution, below
   if (background_flow_) f.row(0) += x.row(1);
   if (second_kind_) {
     timings_.volume_s += seconds_since(t0);

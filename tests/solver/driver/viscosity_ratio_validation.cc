@@ -75,8 +75,9 @@ TEST(ViscosityRatioSphere, SmallDeformationLimitDoesNotDependOnLambda) {
 // rotation takes 2π(r + 1/r)). Measured (level 2): 8.243 at λ = 10 and 8.241 at λ = 20, both 4.9% above Jeffery's and
 // not moving towards it between λ = 10 and 20, so the excess is not the residual tank-treading of a finite λ
 // (Keller & Skalak 1982); the finite Ca (D12 oscillates between 0.27 and 0.39) and the level-2 mesh are the
-// candidates, not yet separated (solver/README.md §3b, "Limits"). Asserted: tumbling, and the period within
-// [0.98, 1.1] × Jeffery's.
+// candidates, not yet separated (solver/README.md §3b, "Limits"). Asserted: tumbling, and the period within 2 % of
+// Jeffery's, the rigid limit this check is for. It FAILS today (4.9 %): the bound was not widened to the measurement,
+// so scripts/validate keeps the open discrepancy visible until its cause is found.
 TEST(ViscosityRatioSpheroid, LargeLambdaTumblesNearJefferysPeriod) {
   const double jeffery = std::numbers::pi * (2.0 + 1.0 / 2.0);
   for (const double lambda : {10.0, 20.0}) {
@@ -90,8 +91,7 @@ TEST(ViscosityRatioSpheroid, LargeLambdaTumblesNearJefferysPeriod) {
     const CaseResult r = run(c, "jeffery_lambda_" + std::to_string(lambda));
     ASSERT_EQ(r.status, "done") << r.reason;
     EXPECT_EQ(r.analysis.regime, diagnostics::Regime::tumbling) << "λ " << lambda;
-    EXPECT_GT(r.analysis.period, 0.98 * jeffery) << "λ " << lambda;
-    EXPECT_LT(r.analysis.period, 1.1 * jeffery) << "λ " << lambda;
+    EXPECT_NEAR(r.analysis.period / jeffery, 1.0, 0.02) << "λ " << lambda;
   }
 }
 

@@ -1,5 +1,5 @@
 #!/bin/bash
-# Level-3 cases of the main preset's run of 2026-12-05 (tag results-archive-52bef5c: results/table1_mf_mixed.sqlite; mixed precision, t_end 40) re-run at time.dt_accuracy=$1.
+# Level-3 cases of an earlier run of the main preset (tag results-archive-52bef5c: results/table1_mf_mixed.sqlite; mixed precision, t_end 40) re-run at time.dt_accuracy=$1.
 # Usage: results/time_steps/whole_cases/run.sh 0.04; run.sh 0.08   (one case after another, 1 thread)
 dta=$1
 B=${CAPSIM:-build/bin/capsim}   # run 2026-12-05 with a copy of commit bdae181

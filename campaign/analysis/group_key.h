@@ -57,6 +57,8 @@ class GroupKey {
   [[nodiscard]] double aspect_ratio() const { return number("capsule.aspect_ratio"); }
   /// @brief capsule.bending_modulus (0, the seed's membrane, when absent).
   [[nodiscard]] double bending_modulus() const { return number("capsule.bending_modulus"); }
+  /// @brief flow.viscosity_ratio λ (1, the seed's capsule, when absent).
+  [[nodiscard]] double viscosity_ratio() const { return number("flow.viscosity_ratio"); }
   /// @brief mesh.level.
   [[nodiscard]] int mesh_level() const { return static_cast<int>(number("mesh.level")); }
   /// @brief time.dt as text: "auto" (the default), else the step as stored JSON (e.g. "0.01").

@@ -44,11 +44,30 @@ std::string law_label(const std::string& law, double C) {
 
 SqlValue value_of(const std::optional<double>& x) { return x ? SqlValue{*x} : SqlValue{nullptr}; }
 
-// capsule.bending_modulus of a transition group (stored only when set: absent means 0, the seed's membrane).
-double bending_modulus_of(const std::string& group_key) {
+// The physical axes of a campaign besides law, a/b and Ca that `query table1` can pick one value of: each a key
+// of the case registry (absent from a stored group key means its default, the seed's capsule), the option that
+// picks it and how the table names it. A new axis (a tilt, an azimuth) is one line here.
+struct PhysicalAxis {
+  const char* key;     // dotted case key
+  const char* option;  // table1's option
+  const char* label;   // the line above a table whose value is not the default
+};
+constexpr PhysicalAxis kPhysicalAxes[] = {
+    {"capsule.bending_modulus", "--bending-modulus", "Bending modulus κ_b"},
+    {"flow.viscosity_ratio", "--viscosity-ratio", "Viscosity ratio λ (inner/outer)"},
+};
+
+// The value of @p axis in a stored group key; the registry's default for a key it does not hold (or a version-2
+// row's empty key).
+double axis_value(const PhysicalAxis& axis, const std::string& group_key) {
+  static const auto defaults = campaign::GroupKey::parse("{}");
   const auto key = campaign::GroupKey::parse(group_key);
-  return key ? key->bending_modulus() : 0.0;
+  return (key ? *key : *defaults).number(axis.key);
 }
+
+bool same_value(double a, double b) { return std::abs(a - b) <= 1e-12 * std::max(1.0, std::abs(b)); }
+
+double bending_modulus_of(const std::string& group_key) { return axis_value(kPhysicalAxes[0], group_key); }
 
 // Every stored field of @p rows (of campaign @p campaign_of[i]) as the JSON and CSV of `query table1` and
 // `query transitions` give them. The first eighteen columns are those table1 has always had, in their order:
@@ -82,8 +101,9 @@ campaign::Table transitions_table(const std::vector<campaign::Transition>& rows,
   return t;
 }
 
+// `only[i]`: the value of kPhysicalAxes[i] asked for (nullopt: any, but one per cell).
 int table1(campaign::Store& store, const std::string& name, campaign::Format fmt, int mesh_level, double skalak_C,
-           std::optional<double> bending_modulus) {
+           const std::vector<std::optional<double>>& only) {
   const std::string camp = resolve_campaign(store, name);
   std::vector<campaign::Transition> rows;
   // Per (law, a/b): the finest mesh level. Two groups there (two Skalak C, or a numerics axis) do not fit in
@@ -93,10 +113,11 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
     // Scan, mesh-check and dt-check groups serve the answer's error; with --mesh-level the user asks for
     // that level whatever its role.
     if (r.role != "answer" && mesh_level < 0) continue;
-    // --bending-modulus picks one κ_b of a campaign with a bending axis (absent from a group key means 0).
-    if (bending_modulus && std::abs(bending_modulus_of(r.group_key) - *bending_modulus) >
-                               1e-12 * std::max(1.0, std::abs(*bending_modulus)))
-      continue;
+    // --bending-modulus, --viscosity-ratio: one value of a campaign with that axis.
+    bool wanted = true;
+    for (std::size_t a = 0; a < std::size(kPhysicalAxes); ++a)
+      if (only[a] && !same_value(axis_value(kPhysicalAxes[a], r.group_key), *only[a])) wanted = false;
+    if (!wanted) continue;
     auto key = std::make_pair(r.law, r.aspect_ratio);
     if (auto it = seen.find(key); it != seen.end()) {
       const auto& first = rows[it->second];
@@ -104,12 +125,14 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
         if (first.skalak_C != r.skalak_C)
           throw BadInput("campaign '" + camp + "' has several skalak_C values for " + r.law + " a/b=" +
                          campaign::canonical_double(r.aspect_ratio) + "; choose one with --skalak-C");
-        if (bending_modulus_of(first.group_key) != bending_modulus_of(r.group_key))
-          throw BadInput("campaign '" + camp + "' has several bending moduli for " + r.law + " a/b=" +
-                         campaign::canonical_double(r.aspect_ratio) + " (" +
-                         campaign::canonical_double(bending_modulus_of(first.group_key)) + " and " +
-                         campaign::canonical_double(bending_modulus_of(r.group_key)) +
-                         "); choose one with --bending-modulus");
+        for (const auto& axis : kPhysicalAxes) {
+          const double u = axis_value(axis, first.group_key), v = axis_value(axis, r.group_key);
+          if (u != v)
+            throw BadInput("campaign '" + camp + "' has several values of " + axis.key + " for " + r.law +
+                           " a/b=" + campaign::canonical_double(r.aspect_ratio) + " (" +
+                           campaign::canonical_double(u) + " and " + campaign::canonical_double(v) +
+                           "); choose one with " + axis.option);
+        }
         throw BadInput("campaign '" + camp + "' has several transition groups for " + r.law + " a/b=" +
                        campaign::canonical_double(r.aspect_ratio) + " at mesh level " + std::to_string(r.mesh_level) +
                        ", they differ in " + campaign::group_difference(first.group_key, r.group_key) +
@@ -120,9 +143,11 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
     seen[key] = rows.size();
     rows.push_back(std::move(r));
   }
-  if (rows.empty() && bending_modulus)
-    throw BadInput("campaign '" + camp + "' has no transitions with capsule.bending_modulus = " +
-                   campaign::canonical_double(*bending_modulus));
+  if (rows.empty())
+    for (std::size_t a = 0; a < std::size(kPhysicalAxes); ++a)
+      if (only[a])
+        throw BadInput("campaign '" + camp + "' has no transitions with " + kPhysicalAxes[a].key + " = " +
+                       campaign::canonical_double(*only[a]));
   if (rows.empty())
     throw BadInput("campaign '" + camp + "' has no transitions yet (run it first: capsim campaign run ...)");
   if (fmt != campaign::Format::kMarkdown) {
@@ -196,10 +221,14 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
     out += "\n† a lower bound: this error lacks a part that had no data (" + parts +
            "); the JSON's *_err_lacks name them per answer.\n";
   }
-  // A membrane with bending stiffness is not the seed's: say so above the table (one value per campaign here,
-  // as two would be two groups per cell, refused above).
-  if (const double kb = bending_modulus_of(rows.front().group_key); kb > 0.0)
-    out = "Bending modulus κ_b = " + campaign::canonical_double(kb) + " (capsule.bending_modulus)\n\n" + out;
+  // A capsule that is not the seed's (bending stiffness, another viscosity ratio): say so above the table (one
+  // value per table, as two would be two groups in a cell, refused above).
+  std::string header;
+  static const auto defaults = campaign::GroupKey::parse("{}");
+  for (const auto& axis : kPhysicalAxes)
+    if (const double x = axis_value(axis, rows.front().group_key); x != defaults->number(axis.key))
+      header += std::string(axis.label) + " = " + campaign::canonical_double(x) + " (" + axis.key + ")\n";
+  if (!header.empty()) out = header + "\n" + out;
   std::printf("%s", out.c_str());
   return 0;
 }
@@ -273,9 +302,11 @@ int query_command(const std::vector<std::string>& args) {
   double skalak_C = -1;
   t1->add_option("--mesh-level", mesh_level, "only this mesh level (default: the finest per group)");
   t1->add_option("--skalak-C", skalak_C, "only this Skalak C");
-  double bending = -1;
-  t1->add_option("--bending-modulus", bending, "only this capsule.bending_modulus (a campaign with a bending axis)")
+  std::vector<std::optional<double>> only(std::size(kPhysicalAxes));
+  t1->add_option("--bending-modulus", only[0], "only this capsule.bending_modulus (a campaign with a bending axis)")
       ->check(CLI::NonNegativeNumber);
+  t1->add_option("--viscosity-ratio", only[1], "only this flow.viscosity_ratio (a campaign with a viscosity_ratio axis)")
+      ->check(CLI::PositiveNumber);
   auto* cs = app.add_subcommand("cases", "cases with their results; CSV export for plotting");
   common(cs);
   std::string law, status;
@@ -302,8 +333,7 @@ int query_command(const std::vector<std::string>& args) {
     const auto fmt = campaign::parse_format(format);
     auto store = campaign::Store::open_readonly(db);
     if (*t1)
-      return table1(*store, camp, fmt, mesh_level, skalak_C,
-                    bending >= 0 ? std::optional<double>(bending) : std::nullopt);
+      return table1(*store, camp, fmt, mesh_level, skalak_C, only);
     if (*cs) return cases(*store, camp, fmt, law, ar, ca_min, ca_max, status);
     if (*tr) return transitions(*store, camp, fmt, role);
     return sql(*store, text, fmt);

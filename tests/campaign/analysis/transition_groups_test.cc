@@ -62,6 +62,36 @@ TEST(TransitionGroups, BendingAxisIsChosenWithBendingModulus) {
   EXPECT_NE(q.err.find("no transitions with capsule.bending_modulus = 0.5"), std::string::npos) << q.err;
 }
 
+// A viscosity-ratio axis, the same way: --viscosity-ratio picks one λ, whose table is headed by its value; the
+// default λ = 1 is the seed's capsule and heads nothing.
+TEST(TransitionGroups, ViscosityRatioAxisIsChosenWithViscosityRatio) {
+  const std::string dir = fresh_dir("transition_groups_lambda");
+  const std::string db = dir + "/study.db";
+  write_file(dir + "/g.toml", prolate_campaign("lambda-axis", "viscosity_ratio = [1.0, 5.0]\n"));
+  auto r = sh(campaign_cmd("FAKE_STEPS=1 FAKE_STEP_S=0.001", dir + "/g.toml", db, "--jobs 2"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto q = sh(exe() + " query table1 --db " + db);
+  EXPECT_EQ(q.code, 2) << q.out;
+  EXPECT_NE(q.err.find("flow.viscosity_ratio"), std::string::npos) << q.err;
+  EXPECT_NE(q.err.find("--viscosity-ratio"), std::string::npos) << q.err;
+  q = sh(exe() + " query table1 --db " + db + " --viscosity-ratio 5");
+  ASSERT_EQ(q.code, 0) << q.err;
+  EXPECT_NE(q.out.find("Viscosity ratio λ (inner/outer) = 5"), std::string::npos) << q.out;
+  q = sh(exe() + " query table1 --db " + db + " --viscosity-ratio 1");
+  ASSERT_EQ(q.code, 0) << q.err;
+  EXPECT_EQ(q.out.find("Viscosity ratio"), std::string::npos) << q.out;
+  q = sh(exe() + " query table1 --db " + db + " --viscosity-ratio 5 --format json");
+  ASSERT_EQ(q.code, 0) << q.err;
+  const auto rows = nlohmann::json::parse(q.out);
+  ASSERT_EQ(rows.size(), 1u) << q.out;
+  EXPECT_DOUBLE_EQ(rows[0]["group_key"]["flow.viscosity_ratio"].get<double>(), 5.0);
+  q = sh(exe() + " query table1 --db " + db + " --viscosity-ratio 2");
+  EXPECT_EQ(q.code, 2) << q.out;
+  EXPECT_NE(q.err.find("no transitions with flow.viscosity_ratio = 2"), std::string::npos) << q.err;
+  q = sh(exe() + " query table1 --db " + db + " --viscosity-ratio -1");
+  EXPECT_EQ(q.code, 2) << q.out;
+}
+
 // campaign status tells the groups apart: its table had one row per group but no column for the key that
 // differs (two rows "neo-hookean 2 level 3" with different κ_b read the same), nor did its problem-case lines.
 TEST(TransitionGroups, StatusNamesTheKeyThatTellsTheGroupsApart) {

@@ -234,7 +234,7 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
 }
 
 int cases(campaign::Store& store, const std::string& name, campaign::Format fmt, const std::string& law,
-          double ar, double ca_min, double ca_max, const std::string& status) {
+          double ar, double ca_min, double ca_max, const std::string& status, double viscosity_ratio) {
   std::string camp;
   if (!name.empty()) camp = resolve_campaign(store, name);
   if (!status.empty() && status != "queued" && status != "running" && status != "done" && status != "unstable" &&
@@ -249,6 +249,7 @@ int cases(campaign::Store& store, const std::string& name, campaign::Format fmt,
   f.ca_min = ca_min;
   f.ca_max = ca_max;
   f.status = status;
+  f.viscosity_ratio = viscosity_ratio;
   auto t = store.cases_table(f);
   if (fmt != campaign::Format::kJson) {
     // The case folder and the stored result line serve scripts (JSON); the tables for reading keep their width.
@@ -317,6 +318,9 @@ int query_command(const std::vector<std::string>& args) {
   cs->add_option("--ca-min", ca_min, "smallest capillary number");
   cs->add_option("--ca-max", ca_max, "largest capillary number");
   cs->add_option("--status", status, "queued, running, done, unstable or failed");
+  double cases_lambda = 0;
+  cs->add_option("--viscosity-ratio", cases_lambda, "only this flow.viscosity_ratio (the column viscosity_ratio)")
+      ->check(CLI::PositiveNumber);
   auto* tr = app.add_subcommand("transitions", "every stored transition group (all mesh levels and roles) with its "
                                                "errors and provenance");
   common(tr);
@@ -334,7 +338,7 @@ int query_command(const std::vector<std::string>& args) {
     auto store = campaign::Store::open_readonly(db);
     if (*t1)
       return table1(*store, camp, fmt, mesh_level, skalak_C, only);
-    if (*cs) return cases(*store, camp, fmt, law, ar, ca_min, ca_max, status);
+    if (*cs) return cases(*store, camp, fmt, law, ar, ca_min, ca_max, status, cases_lambda);
     if (*tr) return transitions(*store, camp, fmt, role);
     return sql(*store, text, fmt);
   } catch (const BadInput& e) {

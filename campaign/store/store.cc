@@ -738,14 +738,21 @@ Table Store::cases_table(const CaseFilter& f) {
          "json_extract(r.raw_json, '$.flow_evaluations') AS flow_evaluations, "
          "CASE WHEN r.case_id IS NULL THEN NULL ELSE " CAPSIM_CASE_THREADS " END AS threads, "
          CAPSIM_CASE_CORE_S " AS core_s, "
-         "c.code_version, c.error, c.h5_path, c.params_json AS params, c.out_dir, r.raw_json AS summary "
+         "c.code_version, c.error, c.h5_path, c.params_json AS params, c.out_dir, r.raw_json AS summary, "
+         // λ: stored in params only where set (a case key at its default is left out of the identity).
+         "coalesce(json_extract(c.params_json, '$.\"flow.viscosity_ratio\"'), ?7) AS viscosity_ratio, "
+         "json_extract(r.raw_json, '$.gmres_iterations_mean') AS gmres_iterations_mean "
          "FROM cases c LEFT JOIN results r ON r.case_id=c.case_id "
          "WHERE (?1 = '' OR c.case_id IN (SELECT cc.case_id FROM campaign_cases cc JOIN campaigns k "
          "ON k.campaign_id=cc.campaign_id WHERE k.name=?1)) "
          "AND (?2 = '' OR c.law = ?2) AND (?3 <= 0 OR abs(c.aspect_ratio - ?3) < 1e-12) "
          "AND c.capillary_number >= ?4 AND c.capillary_number <= ?5 AND (?6 = '' OR c.status = ?6) "
-         "ORDER BY c.law, c.aspect_ratio, c.skalak_C, c.mesh_level, c.capillary_number");
+         "AND (?8 <= 0 OR abs(coalesce(json_extract(c.params_json, '$.\"flow.viscosity_ratio\"'), ?7) - ?8) "
+         "<= 1e-12 * ?8) "
+         "ORDER BY c.law, c.aspect_ratio, c.skalak_C, viscosity_ratio, c.mesh_level, c.capillary_number");
+  const double lambda_default = GroupKey::parse("{}")->viscosity_ratio();  // the key registry's default
   s.bind(1, f.campaign).bind(2, f.law).bind(3, f.aspect_ratio).bind(4, f.ca_min).bind(5, f.ca_max).bind(6, f.status);
+  s.bind(7, lambda_default).bind(8, f.viscosity_ratio);
   Table t = read_table(s);
   t.json_columns = {"summary"};
   return t;

@@ -83,6 +83,7 @@ struct CaseFilter {
   double aspect_ratio = 0;            ///< a/b (<= 0: any)
   double ca_min = 0, ca_max = 1e300;  ///< Ca range
   std::string status;                 ///< case status
+  double viscosity_ratio = 0;         ///< flow.viscosity_ratio λ (<= 0: any)
 };
 
 /// @brief A finished case of a database with its result, as another database can take it over (`capsim campaign

@@ -90,6 +90,22 @@ TEST(TransitionGroups, ViscosityRatioAxisIsChosenWithViscosityRatio) {
   EXPECT_NE(q.err.find("no transitions with flow.viscosity_ratio = 2"), std::string::npos) << q.err;
   q = sh(exe() + " query table1 --db " + db + " --viscosity-ratio -1");
   EXPECT_EQ(q.code, 2) << q.out;
+  // query cases: every case with its λ (1 where the key is at its default, so not stored), and a filter.
+  q = sh(exe() + " query cases --db " + db + " --format json");
+  ASSERT_EQ(q.code, 0) << q.err;
+  const auto all = nlohmann::json::parse(q.out);
+  int at1 = 0, at5 = 0;
+  for (const auto& c : all) (c["viscosity_ratio"].get<double>() == 5.0 ? at5 : at1) += 1;
+  EXPECT_EQ(at1, 4);
+  EXPECT_EQ(at5, 4);
+  q = sh(exe() + " query cases --db " + db + " --viscosity-ratio 5 --format json");
+  ASSERT_EQ(q.code, 0) << q.err;
+  const auto five = nlohmann::json::parse(q.out);
+  ASSERT_EQ(five.size(), 4u) << q.out;
+  for (const auto& c : five) EXPECT_EQ(c["viscosity_ratio"].get<double>(), 5.0);
+  q = sh(exe() + " query cases --db " + db + " --viscosity-ratio 1 --format json");
+  ASSERT_EQ(q.code, 0) << q.err;
+  EXPECT_EQ(nlohmann::json::parse(q.out).size(), 4u) << q.out;
 }
 
 // campaign status tells the groups apart: its table had one row per group but no column for the key that

@@ -16,6 +16,7 @@
 #include "campaign/common/exit_codes.h"
 #include "capsim/schema_sql.h"
 #include "capsim/version.h"
+#include "solver/config/case_config.h"
 #include "solver/driver/case_summary.h"
 
 namespace capsim::campaign {
@@ -89,9 +90,15 @@ std::string result_mismatch(const nlohmann::json& j, const CaseParams& p) {
   } catch (const std::invalid_argument& e) {
     return e.what();
   }
-  const config::MembraneLawKind law = config::from_word<config::MembraneLawKind>(p.law()).value();
-  return driver::parameter_mismatch(s.parameters, {p.capillary_number(), p.aspect_ratio(), law, p.skalak_C(),
-                                                   p.mesh_level(), p.bending_modulus()});
+  // The case's parameters as the solver resolves them (CaseParameters::of, the one list of what a result must
+  // echo): a key added to it (a viscosity ratio, an orientation) is checked here without a change.
+  driver::CaseParameters expected;
+  try {
+    expected = driver::CaseParameters::of(config::parse_case_config(p.to_toml(), "case " + p.to_json()));
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return driver::parameter_mismatch(s.parameters, expected);
 }
 
 void insert_result(Db& db, const std::string& case_id, const nlohmann::json& j, const std::string& line) {

@@ -130,4 +130,15 @@ double CaseParams::estimated_cost() const {
   return dynamics::CostModel::case_cost(c, reference_min_spacing(c));
 }
 
+double CaseParams::estimated_cost_on_level(int level) const {
+  if (level == mesh_level()) return estimated_cost();
+  CaseParams moved = *this;
+  moved.set("mesh.level", std::int64_t{level});
+  try {
+    return moved.estimated_cost();
+  } catch (const config::ConfigError&) {
+    return 0;
+  }
+}
+
 }  // namespace capsim::campaign

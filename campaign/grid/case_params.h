@@ -61,6 +61,9 @@ class CaseParams {
   /// the scene's symmetry, the kernel precision, the bending stiffness's stages, the level).
   /// @throws capsim::config::ConfigError if the solver rejects the case.
   double estimated_cost() const;
+  /// @brief estimated_cost() of the same case on mesh level @p level (the ETA carries a case's measured cost
+  /// from one level to the next by the ratio of the two); 0 if the solver rejects the case on that level.
+  double estimated_cost_on_level(int level) const;
 
  private:
   std::map<std::string, Value> values_;

@@ -194,7 +194,7 @@ class Runner {
     std::map<std::string, double> left;
     if (by_work || coarse_levels_first_)
       for (const auto& r : pending) {
-        const double whole = eta_.expected_s(r.params.mesh_level(), r.est_cost);
+        const double whole = eta_.expected_s(r.params.mesh_level(), r.est_cost, est_below(r));
         left[r.case_id] = (whole >= 0 ? whole : r.est_cost) *
                           (r.resumable ? work_fraction_left(r.out_dir, r.params.t_end()) : 1.0);
       }
@@ -284,11 +284,12 @@ class Runner {
       return *busy.insert(it != cell_of_.end() ? it->second : CellTally::cell_of(r.params)).first;
     };
     // A queued resumable case is counted whole: reading its checkpoint at every redraw is not worth it.
-    for (const auto& r : pending) work.push_back({r.params.mesh_level(), r.est_cost, 1.0, false, 0.0, cell(r)});
+    for (const auto& r : pending)
+      work.push_back({r.params.mesh_level(), r.est_cost, 1.0, false, 0.0, cell(r), est_below(r)});
     const auto now = std::chrono::steady_clock::now();
     for (const auto& [_, r] : running_)
       work.push_back({r.row.params.mesh_level(), r.row.est_cost, r.fraction_left, true,
-                      std::chrono::duration<double>(now - r.start).count(), cell(r.row)});
+                      std::chrono::duration<double>(now - r.start).count(), cell(r.row), est_below(r.row)});
     c.eta_s = tally_ ? eta_.remaining_s(work, jobs_, tally_->outlook(busy)) : eta_.remaining_s(work, jobs_);
     return c;
   }
@@ -322,6 +323,14 @@ class Runner {
 
   // The ETA learns from every finished case of the campaign (learn_eta), earlier runs included.
   void learn_costs() { eta_ = learn_eta(store_, campaign_id_, threads_); }
+
+  // A case's estimate one mesh level coarser (the ETA carries the measured cost of that level to a level with no
+  // finished case yet), computed once per case.
+  double est_below(const CaseRow& r) const {
+    auto it = est_below_.find(r.case_id);
+    if (it == est_below_.end()) it = est_below_.emplace(r.case_id, r.params.estimated_cost_on_level(r.params.mesh_level() - 1)).first;
+    return it->second;
+  }
 
   // Tells the multi-fidelity tally the cases it has not seen: at the first call every case of the campaign,
   // then the batch a top-up or a refinement round added.
@@ -385,6 +394,7 @@ class Runner {
   std::optional<CellTally> tally_;        // multi-fidelity: what refinement will still add, per cell (the ETA's)
   std::map<std::string, std::string> cell_of_;  // case id -> its cell, for every case the tally has been told
   bool tallied_ = false;
+  mutable std::map<std::string, double> est_below_;  // case id -> its estimate one level coarser (est_below)
 };
 
 /// After a manager crash: stop leftover workers, then ingest finished results or requeue.

@@ -48,18 +48,36 @@ double EtaModel::predict_log(const Sums& s, double x) {
   return my + beta * (x - mx) + 0.5 * std::min(var, 1.0);
 }
 
-double EtaModel::expected_s(int mesh_level, double est_cost) const {
+double EtaModel::carried_log(int mesh_level, double x, double x_below, bool coarser_only) const {
+  int nearest = 0;
+  bool found = false;
+  for (const auto& [level, _] : by_level_)  // ascending: on a tie the coarser stays
+    if (level != mesh_level && (!coarser_only || level < mesh_level) &&
+        (!found || std::abs(level - mesh_level) < std::abs(nearest - mesh_level)))
+      nearest = level, found = true;
+  if (!found) return std::nan("");
+  // The case itself, where its estimate on the level below is known and that level is the nearest one.
+  if (nearest == mesh_level - 1 && std::isfinite(x_below)) return law_log(nearest, x_below, std::nan("")) + (x - x_below);
+  // Else at that level's mean ratio of wall to estimate (its prediction at its mean estimate, moved in
+  // proportion).
+  const double mx = by_level_.at(nearest).x / by_level_.at(nearest).n;
+  return law_log(nearest, mx, std::nan("")) + (x - mx);
+}
+
+double EtaModel::law_log(int mesh_level, double x, double x_below) const {
+  const auto it = by_level_.find(mesh_level);
+  if (it == by_level_.end()) return carried_log(mesh_level, x, x_below, false);
+  const double own = predict_log(it->second, x);
+  const double carried = carried_log(mesh_level, x, x_below, true);
+  if (!std::isfinite(carried)) return own;
+  // A level's first cases drawn towards the carry from the coarser level, which counts as kCarryWeight cases.
+  const double n = it->second.n;
+  return (n * own + kCarryWeight * carried) / (n + kCarryWeight);
+}
+
+double EtaModel::expected_s(int mesh_level, double est_cost, double est_cost_below) const {
   if (by_level_.empty() || !(est_cost > 0)) return -1;
-  const double x = std::log(est_cost);
-  if (const auto it = by_level_.find(mesh_level); it != by_level_.end()) return std::exp(predict_log(it->second, x));
-  // No case of this level finished yet: the nearest level that has one (the coarser on a tie), at its mean
-  // ratio of wall to estimate (its law's prediction at its mean estimate, moved in proportion).
-  int nearest = by_level_.begin()->first;
-  for (const auto& [level, _] : by_level_)
-    if (std::abs(level - mesh_level) < std::abs(nearest - mesh_level)) nearest = level;
-  const Sums& s = by_level_.at(nearest);
-  const double mx = s.x / s.n;
-  return std::exp(predict_log(s, mx) + (x - mx));
+  return std::exp(law_log(mesh_level, std::log(est_cost), est_cost_below > 0 ? std::log(est_cost_below) : std::nan("")));
 }
 
 double EtaModel::remaining_s(const std::vector<Work>& cases, int jobs, const std::map<std::string, CellOutlook>& cells) const {
@@ -69,7 +87,7 @@ double EtaModel::remaining_s(const std::vector<Work>& cases, int jobs, const std
   bool overdue = false;
   std::map<std::string, std::pair<double, double>> round_left;  // cell -> (work, longest case) of its queue
   for (const auto& w : cases) {
-    const double e = expected_s(w.mesh_level, w.est_cost) * std::clamp(w.fraction_left, 0.0, 1.0) -
+    const double e = expected_s(w.mesh_level, w.est_cost, w.est_cost_below) * std::clamp(w.fraction_left, 0.0, 1.0) -
                      (w.running ? w.elapsed_s : 0.0);
     overdue |= w.running && e <= 0;
     total += std::max(0.0, e);
@@ -90,7 +108,7 @@ double EtaModel::remaining_s(const std::vector<Work>& cases, int jobs, const std
   rounds_per_cell /= weight;
   for (const auto& [key, c] : cells) {
     if (c.settled) continue;
-    const double e = expected_s(c.answer_level, c.answer_est_cost);
+    const double e = expected_s(c.answer_level, c.answer_est_cost, c.answer_est_cost_below);
     if (!(e > 0)) continue;
     const double rounds_to_come = std::max(0.0, rounds_per_cell - c.answer_rounds);
     const double cases_to_come = c.answer_rounds > 0 ? rounds_to_come * kCasesPerLaterRound : kAnswerCasesPerCell;
@@ -107,6 +125,14 @@ double EtaModel::remaining_s(const std::vector<Work>& cases, int jobs, const std
 
 std::string CellTally::cell_of(const CaseParams& params) { return GroupKey::of(params).cell().str(); }
 
+namespace {
+// log of an estimate on another level, clearing @p known if the solver rejects the case there (estimate 0).
+double log_or_unknown(double est, bool& known) {
+  known = known && est > 0;
+  return est > 0 ? std::log(est) : 0.0;
+}
+}  // namespace
+
 void CellTally::add_batch(const std::vector<std::pair<CaseParams, double>>& cases, bool first) {
   std::set<std::string> rounds;  // cells this batch gives an answer-level round
   for (const auto& [params, est] : cases) {
@@ -114,11 +140,11 @@ void CellTally::add_batch(const std::vector<std::pair<CaseParams, double>>& case
     if (params.mesh_level() == answer_level_) {
       ++c.answer_cases;
       c.answer_log_est += std::log(std::max(est, 1e-300));
+      c.answer_log_est_below += log_or_unknown(params.estimated_cost_on_level(answer_level_ - 1), c.below_known);
       rounds.insert(cell_of(params));
     } else if (params.mesh_level() < answer_level_) {
-      CaseParams moved = params;
-      moved.set("mesh.level", std::int64_t{answer_level_});
-      c.scan_log_est += std::log(std::max(moved.estimated_cost(), 1e-300));
+      c.scan_log_est += std::log(std::max(params.estimated_cost_on_level(answer_level_), 1e-300));
+      c.scan_log_est_below += log_or_unknown(params.estimated_cost_on_level(answer_level_ - 1), c.below_known);
       ++c.scan_cases;
     }
   }
@@ -137,8 +163,13 @@ std::map<std::string, CellOutlook> CellTally::outlook(const std::set<std::string
     o.answer_level = answer_level_;
     o.answer_cases = c.answer_cases;
     o.answer_rounds = c.answer_rounds;
-    if (c.answer_cases > 0) o.answer_est_cost = std::exp(c.answer_log_est / c.answer_cases);
-    else if (c.scan_cases > 0) o.answer_est_cost = std::exp(c.scan_log_est / c.scan_cases);
+    if (c.answer_cases > 0) {
+      o.answer_est_cost = std::exp(c.answer_log_est / c.answer_cases);
+      if (c.below_known) o.answer_est_cost_below = std::exp(c.answer_log_est_below / c.answer_cases);
+    } else if (c.scan_cases > 0) {
+      o.answer_est_cost = std::exp(c.scan_log_est / c.scan_cases);
+      if (c.below_known) o.answer_est_cost_below = std::exp(c.scan_log_est_below / c.scan_cases);
+    }
     o.settled = busy.count(key) == 0;
     out.emplace(key, o);
   }

@@ -53,6 +53,7 @@ class Progress {
 struct CellOutlook {
   int answer_level = 0;        ///< the campaign's answer level ([analysis] levels, the second)
   double answer_est_cost = 0;  ///< estimate of a typical answer-level case of the cell (0: none known)
+  double answer_est_cost_below = 0;  ///< the same typical case's estimate one level coarser (0: none known)
   int answer_cases = 0;        ///< answer-level cases the cell has, any status
   double answer_rounds = 0;    ///< answer-level rounds it has had
   /// None of its cases runs or waits although refinement was asked after its last case ended: it has its
@@ -75,9 +76,15 @@ struct CellOutlook {
 /// databases) as if kPriorWeight cases spread one e-fold in est_cost had measured it: one case, or cases of
 /// one estimate, give β = kCostExponent; a hundred spread cases give their own β. The prediction is the
 /// arithmetic mean (× exp(s²/2), s² the residual variance in log wall), since the ETA sums predictions. A
-/// level with no finished case yet uses the nearest level that has one (the coarser on a tie) at its mean
-/// ratio of wall time to estimate: the cost model carries a case across levels (wall ∝ est, not est^β,
-/// since the same case moves as its estimate does).
+/// level with no finished case yet uses the nearest level that has one (the coarser on a tie): the cost model
+/// carries a case across levels (wall ∝ est, not est^β, since the same case moves as its estimate does). Where
+/// the case's own estimate on that level is known (Work::est_cost_below, the level just coarser), the case is
+/// carried itself: that level's law at its estimate there, times the ratio of its two estimates, so a case
+/// that is expensive on the coarser level is carried at that level's lower wall per estimate (β < 1); else
+/// at that level's mean ratio of wall time to estimate. A level's first finished cases are noisy (a case's
+/// wall time spreads by ×1.4 or more about its level's law), so a level with a coarser one is drawn towards
+/// the prediction carried from it: the weighted mean in log wall of its own law (weight: its finished cases)
+/// and the carry (weight kCarryWeight).
 ///
 /// A multi-fidelity campaign adds cases as it goes (a cell's first answer-level round seeds its brackets, each
 /// later one adds a case or two), which the queue does not hold yet: for each cell not yet settled the ETA adds
@@ -110,11 +117,20 @@ class EtaModel {
   static constexpr double kCasesPerLaterRound = 1.5;
   /// @brief How many settled cells kAnswerRoundsPerCell counts as, against the cells of the campaign itself.
   static constexpr double kPriorCells = 4.0;
+  /// @brief How many finished cases of a level the prediction carried from the coarser level counts as (class
+  /// comment): the ratio of one case's variance about its level's law to the carry's squared error, at its
+  /// smallest. The carry of the same case from level 2 to 3 is off by a factor 0.85 (log error 0.17,
+  /// squared 0.028) over the twins of results/table1/table1_mf_mixed.sqlite
+  /// (EtaModel.TheCostModelCarriesACaseAcrossLevels); a case's residual variance in log wall about its level's
+  /// law is 0.12–0.15 there, 0.20–0.59 in results/table1_certified/table1_certified.sqlite and 0.25–0.42 in
+  /// results/bending/table1_bending.sqlite: 0.12 / 0.028 ≈ 4.
+  static constexpr double kCarryWeight = 4.0;
   /// @brief Records a finished case: its level, estimated cost and measured wall seconds (of the whole
   /// case, all attempts).
   void add_done(int mesh_level, double est_cost, double wall_s);
-  /// @brief Expected wall seconds of a case of @p mesh_level with @p est_cost; < 0 before any case finished.
-  [[nodiscard]] double expected_s(int mesh_level, double est_cost) const;
+  /// @brief Expected wall seconds of a case of @p mesh_level with @p est_cost (and, if known and > 0, its
+  /// estimate @p est_cost_below on mesh level @p mesh_level − 1); < 0 before any case finished.
+  [[nodiscard]] double expected_s(int mesh_level, double est_cost, double est_cost_below = 0) const;
   /// @brief One case still to run or running, as the ETA sees it.
   struct Work {
     int mesh_level = 0;
@@ -126,6 +142,7 @@ class EtaModel {
     bool running = false;
     double elapsed_s = 0;  ///< of the current attempt (running cases)
     std::string cell{};    ///< its multi-fidelity cell (a key of remaining_s's cells), "" for none
+    double est_cost_below = 0;  ///< its estimate on mesh level mesh_level − 1 (0: not known)
   };
   /// @brief Seconds until the last case ends: the predicted work of @p cases (whole-case prediction ×
   /// fraction_left, minus what a running case has run of it) and what @p cells will still add (class
@@ -142,6 +159,12 @@ class EtaModel {
   };
   /// log wall predicted at log est @p x by the law of @p s.
   static double predict_log(const Sums& s, double x);
+  /// log wall of a case of @p mesh_level carried from the nearest other level with a finished case (only a
+  /// coarser one if @p coarser_only), at log est @p x and (NaN: unknown) @p x_below one level coarser (class
+  /// comment); NaN if there is none.
+  double carried_log(int mesh_level, double x, double x_below, bool coarser_only) const;
+  /// log wall predicted for a case of @p mesh_level: its own law drawn towards the carry, or the carry alone.
+  double law_log(int mesh_level, double x, double x_below) const;
   std::map<int, Sums> by_level_;
 };
 
@@ -165,6 +188,8 @@ class CellTally {
     double answer_rounds = 0;
     double answer_log_est = 0;  // Σ log est over its answer-level cases
     double scan_log_est = 0;    // Σ log est over its other cases, each moved to the answer level
+    double answer_log_est_below = 0, scan_log_est_below = 0;  // the same sums one level below the answer level
+    bool below_known = true;  // false if a case of the cell has no estimate one level below the answer level
     int scan_cases = 0;
   };
   int answer_level_;

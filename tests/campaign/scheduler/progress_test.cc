@@ -30,17 +30,34 @@ TEST(EtaModel, UnknownBeforeAnyCaseFinished) {
 }
 
 TEST(EtaModel, EachLevelKeepsItsOwnLaw) {
-  // One finished case per level: its own wall time at its own estimate, the measured exponent elsewhere.
+  // One finished case per level. The coarsest level: its own wall time at its own estimate, the measured
+  // exponent elsewhere.
   EtaModel m;
   m.add_done(2, 10.0, 10.0);
   m.add_done(3, 40.0, 10.0);
   EXPECT_NEAR(m.expected_s(2, 10.0), 10.0, 1e-9);
-  EXPECT_NEAR(m.expected_s(3, 40.0), 10.0, 1e-9);
-  EXPECT_NEAR(m.expected_s(3, 80.0), 10.0 * std::pow(2.0, EtaModel::kCostExponent), 1e-9);
+  EXPECT_NEAR(m.expected_s(2, 20.0), 10.0 * std::pow(2.0, EtaModel::kCostExponent), 1e-9);
+  // The finer level's one case drawn towards the carry from level 2 (wall per estimate 1: 40 s at 40), in
+  // logs with weights 1 and kCarryWeight.
+  const double w = EtaModel::kCarryWeight;
+  const auto blend = [w](double own, double carried) { return std::exp((std::log(own) + w * std::log(carried)) / (1 + w)); };
+  EXPECT_NEAR(m.expected_s(3, 40.0), blend(10.0, 40.0), 1e-9);
+  EXPECT_NEAR(m.expected_s(3, 80.0), blend(10.0 * std::pow(2.0, EtaModel::kCostExponent), 80.0), 1e-9);
+  // With many cases it is their own law: 40 cases at 10 s leave the carry a weight w / (40 + w).
+  for (int i = 0; i < 39; ++i) m.add_done(3, 40.0, 10.0);
+  EXPECT_NEAR(m.expected_s(3, 40.0), std::exp((40 * std::log(10.0) + w * std::log(40.0)) / (40 + w)), 1e-9);
+  EXPECT_LT(m.expected_s(3, 40.0), 1.15 * 10.0);
+  // A case whose estimate one level coarser is known is carried itself: level 2's law at that estimate, times
+  // the ratio of its two estimates (a level-3 case of 40 whose level-2 twin's estimate is 20 is expected at
+  // level 2's prediction at 20, doubled) before the level's own cases draw it.
+  EtaModel carried;
+  carried.add_done(2, 10.0, 10.0);
+  EXPECT_NEAR(carried.expected_s(3, 40.0, 20.0), 2 * 10.0 * std::pow(2.0, EtaModel::kCostExponent), 1e-9);
+  EXPECT_NEAR(carried.expected_s(3, 40.0), 40.0, 1e-9);  // not known: level 2's wall per estimate
   // A level with no finished case borrows the nearest level's ratio of wall to estimate, in proportion to the
   // estimate (the cost model carries a case across levels): a level-4 case of 7x the estimate of a level-3
-  // one of 10 s, and a level-1 case of a seventh of a level-2 one's.
-  EXPECT_NEAR(m.expected_s(4, 40.0 * 7), 7 * 10.0, 1e-9);
+  // one (level 3's prediction at its mean estimate), and a level-1 case of a seventh of a level-2 one's.
+  EXPECT_NEAR(m.expected_s(4, 40.0 * 7), 7 * m.expected_s(3, 40.0), 1e-9);
   EXPECT_NEAR(m.expected_s(1, 10.0 / 7), 10.0 / 7, 1e-9);  // coarser: the other way
 }
 
@@ -103,10 +120,14 @@ TEST(EtaModel, RemainingCountsThePendingWorkNotTheMeanOfWhatFinished) {
   EtaModel m;
   for (int i = 0; i < 10; ++i) m.add_done(2, 1.0, 1.0);
   m.add_done(3, 100.0, 50.0);
-  EXPECT_NEAR(m.remaining_s({{3, 100.0}, {3, 100.0}}, 2), 50.0, 1e-9);
+  // The level-3 prediction: its one case (50 s) drawn towards the carry from level 2 (100 s).
+  const double e100 = m.expected_s(3, 100.0);
+  EXPECT_NEAR(e100, std::exp((std::log(50.0) + EtaModel::kCarryWeight * std::log(100.0)) / (1 + EtaModel::kCarryWeight)),
+              1e-9);
+  EXPECT_NEAR(m.remaining_s({{3, 100.0}, {3, 100.0}}, 2), e100, 1e-9);
   // A running case counts what it still needs; one long case does not split between two workers.
   const double e400 = m.expected_s(3, 400.0);
-  EXPECT_GT(e400, 50.0);
+  EXPECT_GT(e400, e100);
   const auto running = [](double est, double elapsed, double left = 1.0) {
     return EtaModel::Work{3, est, left, true, elapsed};
   };
@@ -301,7 +322,7 @@ TEST(EtaModel, TheMainCommandsEtaIsGoodToThirtyPercent) {
   }
   struct Case {
     CaseParams params;
-    double est = 0, wall = 0, created = 0, started = 0, finished = 0;
+    double est = 0, wall = 0, created = 0, started = 0, finished = 0, est_below = 0;
   };
   std::vector<Case> cases;
   // Seconds from the start of the run day (julianday keeps a millisecond: 1e-10 of a day in 2.46e6 days).
@@ -313,6 +334,7 @@ TEST(EtaModel, TheMainCommandsEtaIsGoodToThirtyPercent) {
   while (s.step()) {
     Case c{CaseParams::from_json(s.text(0)), 0, *s.real(1), *s.real(2), *s.real(3), *s.real(4)};
     c.est = c.params.estimated_cost();
+    c.est_below = c.params.estimated_cost_on_level(c.params.mesh_level() - 1);
     cases.push_back(std::move(c));
   }
   ASSERT_GE(cases.size(), 100u);
@@ -354,6 +376,7 @@ TEST(EtaModel, TheMainCommandsEtaIsGoodToThirtyPercent) {
         w.running = c.started <= t;
         w.elapsed_s = w.running ? t - c.started : 0;
         w.cell = *busy.insert(CellTally::cell_of(c.params)).first;
+        w.est_cost_below = c.est_below;
         work.push_back(w);
       }
     }

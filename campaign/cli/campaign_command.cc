@@ -221,8 +221,11 @@ int status(const std::string& db_path, const std::string& name) {
       // A case with a checkpoint counts the part after it (a running case's is where it has got to).
       std::vector<campaign::EtaModel::Work> left;
       for (const auto& r : store->campaign_cases(c.campaign_id))
-        if (r.status == "queued" || r.status == "running")
-          left.push_back({r.params.mesh_level(), r.est_cost, campaign::work_fraction_left(r.out_dir, r.params.t_end())});
+        if (r.status == "queued" || r.status == "running") {
+          campaign::EtaModel::Work w{r.params.mesh_level(), r.est_cost, campaign::work_fraction_left(r.out_dir, r.params.t_end())};
+          w.est_cost_below = r.params.estimated_cost_on_level(r.params.mesh_level() - 1);
+          left.push_back(w);
+        }
       const double s = left.empty() ? -1 : campaign::learn_eta(*store, c.campaign_id, 1).remaining_s(left, 1);
       if (s > 0)
         std::printf("  work left: about %s core-h in the %zu queued and running cases (from what its finished cases "

@@ -1,6 +1,5 @@
 #include "campaign/grid/case_params.h"
 
-#include <cmath>
 #include <map>
 #include <mutex>
 #include <tuple>
@@ -10,7 +9,7 @@
 #include "campaign/grid/sha256.h"
 #include "capsim/version.h"
 #include "solver/config/case_config.h"
-#include "solver/dynamics/capsule_flow.h"
+#include "solver/dynamics/cost_model.h"
 #include "solver/mesh/mesh.h"
 #include "solver/solver_version.h"
 
@@ -128,14 +127,18 @@ double reference_min_spacing(const config::CaseConfig& c) {
 
 double CaseParams::estimated_cost() const {
   const config::CaseConfig c = config::parse_case_config(to_toml(), "case " + to_json());
-  return c.t_end * dynamics::evaluations_per_unit_time(c, reference_min_spacing(c)) *
-         std::pow(kEvaluationCostPerLevel, c.level) *
-         (c.kernel_precision == "mixed" ? mixed_precision_cost_factor(c.level) : 1.0);
+  return dynamics::CostModel::case_cost(c, reference_min_spacing(c));
 }
 
-double CaseParams::mixed_precision_cost_factor(int level) {
-  const double sum = kRegularShareLevel3 * std::pow(16.0, level - 3), rest = std::pow(4.0, level - 3);
-  return (sum / kMixedSumSpeedup + rest) / (sum + rest);
+double CaseParams::estimated_cost_on_level(int level) const {
+  if (level == mesh_level()) return estimated_cost();
+  CaseParams moved = *this;
+  moved.set("mesh.level", std::int64_t{level});
+  try {
+    return moved.estimated_cost();
+  } catch (const config::ConfigError&) {
+    return 0;
+  }
 }
 
 }  // namespace capsim::campaign

@@ -56,32 +56,14 @@ class CaseParams {
   std::string to_json() const;
   /// @brief A case file for `capsim run` (TOML sections).
   std::string to_toml() const;
-  /// @brief Relative cost estimate, for the order cases start in and the ETA's per-level fit:
-  ///   t_end · (flow evaluations per unit time) · kEvaluationCostPerLevel^level,
-  /// the evaluations per unit time from the solver's own step rule on the reference mesh
-  /// (dynamics::evaluations_per_unit_time: the RKC stages grow as (Ca h)^−1/2, with bending as
-  /// sqrt(1 + ρ_b/ρ_el)). Not a prediction of seconds: prestress adds stages along a run and periodic cases
-  /// stop before t_end (the EtaModel fits wall ∝ est^β per level). With numerics.kernel_precision = "mixed"
-  /// the estimate is multiplied by mixed_precision_cost_factor(level).
+  /// @brief Relative cost estimate, for the order cases start in and the progress ETA: the one cost model's
+  /// dynamics::CostModel::case_cost of the resolved case (solver/dynamics/cost_model.h says what it holds:
+  /// the scene's symmetry, the kernel precision, the bending stiffness's stages, the level).
   /// @throws capsim::config::ConfigError if the solver rejects the case.
   double estimated_cost() const;
-  /// @brief What a flow evaluation costs in mixed precision relative to double on mesh level @p level:
-  ///   (S 16^(L−3) / kMixedSumSpeedup + R 4^(L−3)) / (S 16^(L−3) + R 4^(L−3)),
-  /// an evaluation being the all-pairs regular sum S (∝ N², the only part mixed precision speeds up) plus the
-  /// O(N) rest R (singular and near-singular corrections, membrane, load). S : R = kRegularShareLevel3 at
-  /// level 3; the factor is ≈ 0.85, 0.65, 0.49 on levels 2, 3, 4 (the evaluations measured 0.61 and 0.45 on
-  /// levels 3 and 4, `capsim bench flow --precision mixed`).
-  static double mixed_precision_cost_factor(int level);
-  /// @brief S / R of a double-precision level-3 evaluation: the bare regular sum 18.5 ms of 32.0 ms (1 thread,
-  /// symmetric scene; results/benchmarks.md, "Flow evaluation by phase").
-  static constexpr double kRegularShareLevel3 = 18.5 / (32.0 - 18.5);
-  /// @brief How much faster the regular sum is in mixed precision inside an evaluation: 18.5 ms against 7.4 ms
-  /// at level 3 (results/benchmarks.md, "Mixed precision").
-  static constexpr double kMixedSumSpeedup = 2.5;
-  /// @brief What one flow evaluation costs per mesh level finer (×4 nodes): the all-pairs sum alone would be
-  /// 16, the near and singular parts 4; `capsim bench flow` measured 8.2 (mixed) and 10.3 (double) from level 3
-  /// to 4 (results/speed/bench_flow_L{3,4}_T1*.json).
-  static constexpr double kEvaluationCostPerLevel = 9.0;
+  /// @brief estimated_cost() of the same case on mesh level @p level (the ETA carries a case's measured cost
+  /// from one level to the next by the ratio of the two); 0 if the solver rejects the case on that level.
+  double estimated_cost_on_level(int level) const;
 
  private:
   std::map<std::string, Value> values_;

@@ -17,6 +17,7 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -97,6 +98,9 @@ class Runner {
   /// cell's whole answer level, and a cell's next round waits for the last case of its round
   /// (order_by_level_and_cell).
   void set_coarse_levels_first(bool on) { coarse_levels_first_ = on; }
+  /// A multi-fidelity campaign's answer level: the ETA then counts what refinement will still add to each
+  /// cell (CellTally, EtaModel::remaining_s).
+  void set_answer_level(int level) { tally_.emplace(level); }
 
   /// Runs every queued case of the campaign (and what the top-up adds meanwhile); returns false if stopped
   /// by a signal.
@@ -104,6 +108,7 @@ class Runner {
     learn_costs();
     started_cells_.clear();  // nothing runs yet
     auto rows = store_.campaign_cases(campaign_id_);
+    tell_tally(rows);
     std::vector<CaseRow> pending = startable(rows);
     order(pending);
     total_ = static_cast<int>(rows.size());
@@ -141,6 +146,7 @@ class Runner {
         for (const auto& r : pending) unfinished.push_back(r.params);
         if (top_up_(unfinished) > 0) {
           rows = store_.campaign_cases(campaign_id_);
+          tell_tally(rows);
           pending = startable(rows);  // the queue with the new cases, in --order
           order(pending);
           total_ = static_cast<int>(rows.size());
@@ -188,7 +194,7 @@ class Runner {
     std::map<std::string, double> left;
     if (by_work || coarse_levels_first_)
       for (const auto& r : pending) {
-        const double whole = eta_.expected_s(r.params.mesh_level(), r.est_cost);
+        const double whole = eta_.expected_s(r.params.mesh_level(), r.est_cost, est_below(r));
         left[r.case_id] = (whole >= 0 ? whole : r.est_cost) *
                           (r.resumable ? work_fraction_left(r.out_dir, r.params.t_end()) : 1.0);
       }
@@ -271,13 +277,20 @@ class Runner {
     c.queued = queued_;
     std::vector<EtaModel::Work> work;
     work.reserve(pending.size() + running_.size());
+    std::set<std::string> busy;  // multi-fidelity: the cells with a case running or waiting
+    const auto cell = [&](const CaseRow& r) {
+      if (!tally_) return std::string();
+      const auto it = cell_of_.find(r.case_id);
+      return *busy.insert(it != cell_of_.end() ? it->second : CellTally::cell_of(r.params)).first;
+    };
     // A queued resumable case is counted whole: reading its checkpoint at every redraw is not worth it.
-    for (const auto& r : pending) work.push_back({r.params.mesh_level(), r.est_cost, 1.0, false, 0.0});
+    for (const auto& r : pending)
+      work.push_back({r.params.mesh_level(), r.est_cost, 1.0, false, 0.0, cell(r), est_below(r)});
     const auto now = std::chrono::steady_clock::now();
     for (const auto& [_, r] : running_)
       work.push_back({r.row.params.mesh_level(), r.row.est_cost, r.fraction_left, true,
-                      std::chrono::duration<double>(now - r.start).count()});
-    c.eta_s = eta_.remaining_s(work, jobs_);
+                      std::chrono::duration<double>(now - r.start).count(), cell(r.row), est_below(r.row)});
+    c.eta_s = tally_ ? eta_.remaining_s(work, jobs_, tally_->outlook(busy)) : eta_.remaining_s(work, jobs_);
     return c;
   }
 
@@ -310,6 +323,28 @@ class Runner {
 
   // The ETA learns from every finished case of the campaign (learn_eta), earlier runs included.
   void learn_costs() { eta_ = learn_eta(store_, campaign_id_, threads_); }
+
+  // A case's estimate one mesh level coarser (the ETA carries the measured cost of that level to a level with no
+  // finished case yet), computed once per case.
+  double est_below(const CaseRow& r) const {
+    auto it = est_below_.find(r.case_id);
+    if (it == est_below_.end()) it = est_below_.emplace(r.case_id, r.params.estimated_cost_on_level(r.params.mesh_level() - 1)).first;
+    return it->second;
+  }
+
+  // Tells the multi-fidelity tally the cases it has not seen: at the first call every case of the campaign,
+  // then the batch a top-up or a refinement round added.
+  void tell_tally(const std::vector<CaseRow>& rows) {
+    if (!tally_) return;
+    std::vector<std::pair<CaseParams, double>> batch;
+    for (const auto& r : rows)
+      if (!cell_of_.count(r.case_id)) {
+        cell_of_.emplace(r.case_id, CellTally::cell_of(r.params));
+        batch.emplace_back(r.params, r.est_cost);
+      }
+    if (!batch.empty()) tally_->add_batch(batch, !tallied_);
+    tallied_ = true;
+  }
 
   void reap() {
     while (true) {
@@ -356,6 +391,10 @@ class Runner {
   TopUp top_up_;  // empty: the queue is all there is until run_queued returns
   bool coarse_levels_first_ = false;
   std::set<std::string> started_cells_;  // multi-fidelity: the cells a case of whose current round has started
+  std::optional<CellTally> tally_;        // multi-fidelity: what refinement will still add, per cell (the ETA's)
+  std::map<std::string, std::string> cell_of_;  // case id -> its cell, for every case the tally has been told
+  bool tallied_ = false;
+  mutable std::map<std::string, double> est_below_;  // case id -> its estimate one level coarser (est_below)
 };
 
 /// After a manager crash: stop leftover workers, then ingest finished results or requeue.
@@ -666,6 +705,7 @@ int run_campaign(const RunOptions& opt, const BeforeRun& before_run) {
   // level the queue also goes cell by cell, a started round first, then the cells with the most queued work
   // (Runner::order).
   runner.set_coarse_levels_first(multi_fidelity);
+  if (spec.analysis.levels.size() >= 2) runner.set_answer_level(spec.analysis.levels[1]);
   if (multi_fidelity)
     runner.set_top_up([&](const std::vector<CaseParams>& unfinished) {
       std::string what;

@@ -10,6 +10,7 @@
 
 #include "solver/config/case_config.h"
 #include "solver/dynamics/capsule_flow.h"
+#include "solver/dynamics/cost_model.h"
 #include "solver/stokes/source_layout.h"
 
 namespace capsim::dynamics {
@@ -187,9 +188,12 @@ FlowBenchReport bench_flow(const FlowBenchOptions& options) {
   report.level = c.level;
   report.threads = omp_get_max_threads();
   report.isa = stokes::kernel::kernel_isa();
-  // Automatic repeat: the level-3 general evaluation takes ≈ 10–50 ms; the cost grows ≈ 4–8× per level.
-  const int repeat =
-      options.repeat > 0 ? options.repeat : std::clamp(static_cast<int>(40.0 * std::pow(4.0, 3 - c.level)), 5, 400);
+  // Automatic repeat: 40 on level 3 (≈ 1–2 s for the general scene), as many more or fewer as the cost model
+  // puts the evaluation cheaper or dearer on this level.
+  const bool mixed = c.kernel_precision == "mixed";
+  const double per_level = CostModel::evaluation_ms(3, SceneSymmetry::kNone, mixed) /
+                           CostModel::evaluation_ms(c.level, SceneSymmetry::kNone, mixed);
+  const int repeat = options.repeat > 0 ? options.repeat : std::clamp(static_cast<int>(40.0 * per_level), 5, 400);
   for (const bool symmetric : {true, false})
     report.scenes.push_back(measure_scene(flow, in_double.get(), equal_viscosity.get(),
                                           deformed(flow.reference(), symmetric), symmetric ? "symmetric" : "general",

@@ -9,6 +9,7 @@
 #include "campaign/grid/sha256.h"
 #include "campaign/grid/case_keys.h"
 #include "solver/config/case_config.h"
+#include "solver/dynamics/cost_model.h"
 
 namespace capsim::campaign {
 namespace {
@@ -277,22 +278,28 @@ TEST(Identity, JsonRoundTripKeepsIdentity) {
   EXPECT_THROW(CaseParams::from_json("{\"mesh.lvl\": 2}"), BadInput);
 }
 
-// Mixed precision speeds up only the all-pairs sum, whose share of an evaluation grows with the level: the
-// estimate of a mixed case is the double one times the evaluation model's factor, which falls with the level
-// towards 1 / kMixedSumSpeedup. (How near it is to what `capsim bench flow` measures is a measurement: the
-// header and results/benchmarks.md, not a test.)
-TEST(CostEstimate, MixedPrecisionScalesTheEstimateByTheEvaluationModel) {
+// The estimate is the cost model's (solver/dynamics/cost_model.h): mixed precision scales a case by the ratio of
+// the model's mixed to double evaluation, and the central symmetry by its evaluation on a quarter of the nodes
+// and half the membrane; neither touches the step rule, so the evaluations per unit time cancel.
+TEST(CostEstimate, PrecisionAndSymmetryScaleTheEstimateByTheEvaluationModel) {
+  using dynamics::CostModel;
+  using dynamics::SceneSymmetry;
   for (int level : {2, 3, 4}) {
-    CaseParams d = base(), m = base();
+    CaseParams d = base(), m = base(), c = base();
     d.set("mesh.level", std::int64_t{level});
     m.set("mesh.level", std::int64_t{level});
+    c.set("mesh.level", std::int64_t{level});
     m.set("numerics.kernel_precision", std::string("mixed"));
-    EXPECT_NEAR(m.estimated_cost() / d.estimated_cost(), CaseParams::mixed_precision_cost_factor(level), 1e-12);
+    c.set("numerics.central_symmetry", true);
+    EXPECT_NEAR(m.estimated_cost() / d.estimated_cost(),
+                CostModel::evaluation_ms(level, SceneSymmetry::kMirror, true) /
+                    CostModel::evaluation_ms(level, SceneSymmetry::kMirror, false),
+                1e-12);
+    EXPECT_NEAR(c.estimated_cost() / d.estimated_cost(),
+                CostModel::evaluation_ms(level, SceneSymmetry::kMirrorAndCentral, false) /
+                    CostModel::evaluation_ms(level, SceneSymmetry::kMirror, false),
+                1e-12);
   }
-  for (int level = 1; level < 8; ++level)
-    EXPECT_LT(CaseParams::mixed_precision_cost_factor(level + 1), CaseParams::mixed_precision_cost_factor(level));
-  EXPECT_NEAR(CaseParams::mixed_precision_cost_factor(10), 1 / CaseParams::kMixedSumSpeedup, 1e-3);
-  EXPECT_NEAR(CaseParams::mixed_precision_cost_factor(-10), 1.0, 1e-3);  // tiny meshes: the O(N) rest dominates
 }
 
 TEST(Grid, CaseTomlHasSections) {

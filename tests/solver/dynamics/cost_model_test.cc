@@ -1,0 +1,102 @@
+// The one cost model: its limits (what each part of an evaluation scales as), the symmetry a scene uses, the
+// features that change a case's cost. How near it is to measured evaluations is in its header's constants and
+// results/benchmarks.md; EtaModel.TheCostModelCarriesACaseAcrossLevels checks it on whole committed cases.
+#include "solver/dynamics/cost_model.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <utility>
+
+#include "solver/dynamics/capsule_flow.h"
+#include "solver/mesh/mesh.h"
+
+namespace capsim::dynamics {
+namespace {
+
+constexpr SceneSymmetry kAll[] = {SceneSymmetry::kNone, SceneSymmetry::kMirror, SceneSymmetry::kMirrorAndCentral};
+
+// Per level finer the all-pairs sum grows 16× (targets × sources) and everything else 4× (per node): the
+// model's growth lies between, tends to 16 on fine meshes and to 4 on coarse ones, and grows with the level.
+TEST(CostModel, AnEvaluationGrowsBetweenFourAndSixteenTimesPerLevel) {
+  for (const auto sym : kAll)
+    for (const bool mixed : {false, true}) {
+      double previous = 4.0;
+      for (int level = -4; level < 12; ++level) {
+        const double growth = CostModel::evaluation_ms(level + 1, sym, mixed) / CostModel::evaluation_ms(level, sym, mixed);
+        EXPECT_GT(growth, previous) << level;
+        EXPECT_LT(growth, 16.0) << level;
+        previous = growth;
+      }
+      EXPECT_NEAR(CostModel::evaluation_ms(13, sym, mixed) / CostModel::evaluation_ms(12, sym, mixed), 16.0, 1e-3);
+      EXPECT_NEAR(CostModel::evaluation_ms(-7, sym, mixed) / CostModel::evaluation_ms(-8, sym, mixed), 4.0, 1e-3);
+    }
+}
+
+// The mirror halves the boundary integral's targets, the point symmetry halves them again and the membrane's
+// elements too; the layout and the volume correction stay whole. On fine meshes, where the boundary integral is
+// all, each symmetry halves an evaluation; on coarse ones less.
+TEST(CostModel, EachSymmetryHalvesTheBoundaryIntegral) {
+  for (const bool mixed : {false, true})
+    for (int level = 0; level <= 6; ++level) {
+      const double none = CostModel::evaluation_ms(level, SceneSymmetry::kNone, mixed);
+      const double mirror = CostModel::evaluation_ms(level, SceneSymmetry::kMirror, mixed);
+      const double central = CostModel::evaluation_ms(level, SceneSymmetry::kMirrorAndCentral, mixed);
+      EXPECT_GT(none / mirror, 1.0);
+      EXPECT_LT(none / mirror, 2.0);
+      EXPECT_GT(mirror / central, 1.0);
+      EXPECT_LT(mirror / central, 2.0);
+    }
+  for (const auto& [finer, coarser] : {std::pair{SceneSymmetry::kNone, SceneSymmetry::kMirror},
+                                       std::pair{SceneSymmetry::kMirror, SceneSymmetry::kMirrorAndCentral}})
+    EXPECT_NEAR(CostModel::evaluation_ms(12, finer, false) / CostModel::evaluation_ms(12, coarser, false), 2.0, 1e-4);
+}
+
+// Mixed precision speeds up the all-pairs sum only: its saving grows with the level, towards kMixedSumSpeedup.
+TEST(CostModel, MixedPrecisionSavesMoreOnFinerMeshes) {
+  for (const auto sym : kAll) {
+    double previous = 1.0;
+    for (int level = 0; level <= 8; ++level) {
+      const double factor = CostModel::evaluation_ms(level, sym, true) / CostModel::evaluation_ms(level, sym, false);
+      EXPECT_LT(factor, previous) << level;
+      previous = factor;
+    }
+    EXPECT_NEAR(CostModel::evaluation_ms(14, sym, true) / CostModel::evaluation_ms(14, sym, false),
+                1.0 / CostModel::kMixedSumSpeedup, 1e-3);
+  }
+}
+
+// The scene's symmetry is what the solver uses: the mirror always (every scene starts in the shear plane), the
+// point symmetry where numerics.central_symmetry asks for it.
+TEST(CostModel, TheSceneUsesTheSymmetryItsKeysAskFor) {
+  config::CaseConfig c;
+  EXPECT_EQ(CostModel::symmetry(c), SceneSymmetry::kMirror);
+  c.central_symmetry = true;
+  EXPECT_EQ(CostModel::symmetry(c), SceneSymmetry::kMirrorAndCentral);
+  EXPECT_EQ(CostModel::evaluation_ms(c), CostModel::evaluation_ms(c.level, SceneSymmetry::kMirrorAndCentral, false));
+  c.kernel_precision = "mixed";
+  EXPECT_EQ(CostModel::evaluation_ms(c), CostModel::evaluation_ms(c.level, SceneSymmetry::kMirrorAndCentral, true));
+}
+
+// A case: t_end × the step rule's evaluations per unit time × an evaluation × one solve each (λ = 1). Bending
+// stiffness costs through the step rule alone (more RKC stages), not through the evaluation.
+TEST(CostModel, ACaseIsItsEvaluationsTimesAnEvaluation) {
+  config::CaseConfig c;
+  c.level = 2;
+  c.capillary_number = 0.1;
+  const auto m = mesh::make_capsule_mesh(c.level, c.aspect_ratio);
+  const double h = mesh::min_node_spacing(m, m.nodes);
+  EXPECT_EQ(CostModel::solves_per_evaluation(c), 1.0);
+  EXPECT_NEAR(CostModel::case_cost(c, h), c.t_end * evaluations_per_unit_time(c, h) * CostModel::evaluation_ms(c) / 1000,
+              1e-12 * CostModel::case_cost(c, h));
+  config::CaseConfig bent = c;
+  bent.bending_modulus = 0.01;
+  EXPECT_EQ(CostModel::evaluation_ms(bent), CostModel::evaluation_ms(c));
+  EXPECT_GT(CostModel::case_cost(bent, h), 1.5 * CostModel::case_cost(c, h));
+  config::CaseConfig longer = c;
+  longer.t_end = 2 * c.t_end;
+  EXPECT_NEAR(CostModel::case_cost(longer, h), 2 * CostModel::case_cost(c, h), 1e-12 * CostModel::case_cost(c, h));
+}
+
+}  // namespace
+}  // namespace capsim::dynamics

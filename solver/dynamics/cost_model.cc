@@ -19,14 +19,25 @@ double CostModel::evaluation_ms(int level, SceneSymmetry symmetry, bool mixed_pr
 }
 
 double CostModel::evaluation_ms(const config::CaseConfig& config) {
-  return evaluation_ms(config.level, symmetry(config), config.kernel_precision == "mixed");
+  const double single = evaluation_ms(config.level, symmetry(config), config.kernel_precision == "mixed");
+  const double applications = double_layer_applications(config);
+  if (applications == 0.0) return single;  // λ = 1: the single layer alone
+  return single + applications * double_layer_ms(config.level, symmetry(config));
 }
 
-double CostModel::solves_per_evaluation(const config::CaseConfig&) { return 1.0; }
+double CostModel::double_layer_applications(const config::CaseConfig& config) {
+  if (config.viscosity_ratio == 1.0) return 0.0;
+  return kGmresIterationsPerDecade * -std::log10(config.viscosity_tolerance);
+}
+
+double CostModel::double_layer_ms(int level, SceneSymmetry symmetry) {
+  const double targets = symmetry == SceneSymmetry::kNone ? 1.0 : symmetry == SceneSymmetry::kMirror ? 2.0 : 4.0;
+  return kDoubleLayerPerSingleLayer *
+         (kRegularSumMs * std::pow(16.0, level - 3) + kCorrectionsMs * std::pow(4.0, level - 3)) / targets;
+}
 
 double CostModel::case_cost(const config::CaseConfig& config, double h_min) {
-  return config.t_end * evaluations_per_unit_time(config, h_min) * evaluation_ms(config) *
-         solves_per_evaluation(config) / 1000.0;
+  return config.t_end * evaluations_per_unit_time(config, h_min) * evaluation_ms(config) / 1000.0;
 }
 
 }  // namespace capsim::dynamics

@@ -29,13 +29,19 @@ enum class SceneSymmetry {
 /// the central symmetry, else 1), p = 1 / kMixedSumSpeedup
 /// with numerics.kernel_precision = "mixed" (only the all-pairs sum gets faster), else 1. A case costs
 ///
-///     t_end · (flow evaluations per unit time) · E(L) · (solves per evaluation),
+///     t_end · (flow evaluations per unit time) · (E(L) + n_D · D(L)),
 ///
 /// the evaluations per unit time from the solver's own step rule on the reference mesh
-/// (evaluations_per_unit_time: the RKC stages grow as (Ca h)^−1/2, and with the bending stiffness
-/// capsule.bending_modulus as sqrt(1 + ρ_b/ρ_el)). Solves per evaluation is 1 at viscosity ratio λ = 1, the
-/// single layer alone: where λ ≠ 1 (the double layer, solved by GMRES) it becomes the expected iterations per
-/// evaluation (solves_per_evaluation is the one place to change).
+/// (evaluations_per_unit_time: the RKC stages grow as (Ca h)^−1/2, with the bending stiffness
+/// capsule.bending_modulus as sqrt(1 + ρ_b/ρ_el), and with a viscosity ratio λ as sqrt(2/(1 + λ)), the stiffness
+/// factor). At λ ≠ 1 each evaluation also solves the second-kind equation: n_D applications of the double layer
+/// (double_layer_applications: the GMRES iterations, about kGmresIterationsPerDecade per decade of
+/// numerics.viscosity_tolerance), each costing
+///
+///     D(L) = kDoubleLayerPerSingleLayer · (kRegularSumMs · 16^(L−3) + kCorrectionsMs · 4^(L−3)) / σ
+///
+/// (the double layer has the single layer's quadrature and symmetries, in double precision only). n_D = 0 at
+/// λ = 1.
 ///
 /// Not a prediction of seconds: periodic cases stop before t_end, the prestress adds stages along a run, and
 /// other machines share the work out differently (the AVX-512 kernel makes the all-pairs sum a smaller share).
@@ -51,8 +57,11 @@ class CostModel {
   static double evaluation_ms(int level, SceneSymmetry symmetry, bool mixed_precision);
   /// @brief Milliseconds of one flow evaluation of @p config's scene.
   static double evaluation_ms(const config::CaseConfig& config);
-  /// @brief Solves of the boundary-integral system per flow evaluation: 1 (the single layer at λ = 1).
-  static double solves_per_evaluation(const config::CaseConfig& config);
+  /// @brief Applications of the double layer per flow evaluation: 0 at λ = 1, else the expected GMRES
+  /// iterations of a warm-started solve to numerics.viscosity_tolerance (kGmresIterationsPerDecade per decade).
+  static double double_layer_applications(const config::CaseConfig& config);
+  /// @brief Milliseconds of one application of the double layer on mesh level @p level (class comment).
+  static double double_layer_ms(int level, SceneSymmetry symmetry);
   /// @brief Relative cost of a whole case whose reference mesh has smallest node spacing @p h_min, in
   /// seconds of the reference machine (see the class comment for what that is not).
   static double case_cost(const config::CaseConfig& config, double h_min);
@@ -72,6 +81,14 @@ class CostModel {
   /// @brief How much faster the regular sum is in mixed precision inside an evaluation: 18.5 ms against
   /// 7.4 ms at level 3 (results/benchmarks.md, "Mixed precision").
   static constexpr double kMixedSumSpeedup = 2.5;
+  /// @brief One double-layer application against the double-precision single layer of the same scene: 1.6
+  /// (solver/README.md §3b, "Cost": 23.4 against 14.8 ms on the general scene, 6.6 against 4.1 on the symmetric
+  /// and central one, level 3, 1 thread).
+  static constexpr double kDoubleLayerPerSingleLayer = 1.6;
+  /// @brief Warm-started GMRES iterations per decade of the relative tolerance: 7.65 at 1e-8, 5.66 at 1e-6 and
+  /// 3.27 at 1e-4 (λ = 5, level 2; results/validation/README.md, "Tolerance of the solve"); 8.56 at 1e-8 with the
+  /// main preset's numerics (results/benchmarks.md, "Whole cases at a viscosity ratio"): about one per decade.
+  static constexpr double kGmresIterationsPerDecade = 1.0;
 };
 
 }  // namespace capsim::dynamics

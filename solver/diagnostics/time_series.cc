@@ -1,5 +1,9 @@
 #include "solver/diagnostics/time_series.h"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
 #include <stdexcept>
 
 #include "solver/diagnostics/shape_moments.h"
@@ -21,7 +25,52 @@ StepRecord measure_step(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x
   r.volume = m.volume;
   r.area = m.area;
   r.P = {x(0, p_node), x(1, p_node), x(2, p_node)};
+  const MaterialAxis ax = material_axis(mesh, x);
+  r.axis = ax.axis;
+  r.axis_tilt = ax.tilt;
+  r.axis_azimuth = ax.azimuth;
   return r;
+}
+
+MaterialAxis material_axis(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x) {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  const auto [a, b] = mesh.pole_node;
+  if (a < 0 || b < 0 || a >= x.cols() || b >= x.cols()) return {{kNaN, kNaN, kNaN}, kNaN, kNaN};
+  const Eigen::Vector3d d = x.col(a) - x.col(b);
+  const double n = d.norm();
+  if (!(n > 0.0)) return {{kNaN, kNaN, kNaN}, kNaN, kNaN};
+  const Eigen::Vector3d p = d / n;
+  constexpr double kDeg = 180.0 / std::numbers::pi;
+  MaterialAxis m;
+  m.axis = {p(0), p(1), p(2)};
+  // The tilt from the in-plane length, not asin(|p3|): atan2 keeps full accuracy near 90° as well as near 0.
+  m.tilt = std::atan2(std::abs(p(2)), std::hypot(p(0), p(1))) * kDeg;
+  // The axis is a line: its projection's angle is taken modulo 180°, in (−90, 90] like the inclination θ (0 when
+  // the projection vanishes, the axis along x3). An exact 0 of p1 gives +90 whichever sign p2 has.
+  double phi = std::atan2(p(1), p(0)) * kDeg;
+  if (phi <= -90.0) phi += 180.0;
+  if (phi > 90.0) phi -= 180.0;
+  m.azimuth = phi;
+  return m;
+}
+
+double final_tilt(const TimeSeries& s, double t_begin, double t_end) {
+  if (s.empty()) return std::numeric_limits<double>::quiet_NaN();
+  t_begin = std::max(t_begin, s.t.front());
+  t_end = std::min(t_end, s.t.back());
+  if (!(t_begin < t_end)) return s.axis_tilt.back();
+  // The tilt at time t, linear between samples i − 1 and i.
+  auto at = [&](std::size_t i, double t) {
+    const double w = (t - s.t[i - 1]) / (s.t[i] - s.t[i - 1]);
+    return s.axis_tilt[i - 1] + w * (s.axis_tilt[i] - s.axis_tilt[i - 1]);
+  };
+  double integral = 0.0;
+  for (std::size_t i = 1; i < s.size(); ++i) {
+    const double lo = std::max(s.t[i - 1], t_begin), hi = std::min(s.t[i], t_end);
+    if (hi <= lo) continue;
+    integral += 0.5 * (at(i, lo) + at(i, hi)) * (hi - lo);
+  }
+  return integral / (t_end - t_begin);
 }
 
 void TimeSeries::push_back(const StepRecord& r) {
@@ -36,24 +85,31 @@ void TimeSeries::push_back(const StepRecord& r) {
   P.push_back(r.P);
   bending_energy.push_back(r.bending_energy);
   max_bending_moment.push_back(r.max_bending_moment);
+  axis_x1.push_back(r.axis[0]);
+  axis_x2.push_back(r.axis[1]);
+  axis_x3.push_back(r.axis[2]);
+  axis_tilt.push_back(r.axis_tilt);
+  axis_azimuth.push_back(r.axis_azimuth);
 }
 
 StepRecord TimeSeries::at(std::size_t i) const {
   if (i >= size()) throw std::out_of_range("TimeSeries::at: index out of range");
   return {t[i], D12[i], L1[i], L2[i], theta[i], tau_min[i], volume[i], area[i], P[i], bending_energy[i],
-          max_bending_moment[i]};
+          max_bending_moment[i], {axis_x1[i], axis_x2[i], axis_x3[i]}, axis_tilt[i], axis_azimuth[i]};
 }
 
 void TimeSeries::truncate(std::size_t n) {
   if (n >= size()) return;
-  for (auto* c : {&t, &D12, &L1, &L2, &theta, &tau_min, &volume, &area, &bending_energy, &max_bending_moment})
+  for (auto* c : {&t, &D12, &L1, &L2, &theta, &tau_min, &volume, &area, &bending_energy, &max_bending_moment, &axis_x1,
+                 &axis_x2, &axis_x3, &axis_tilt, &axis_azimuth})
     c->resize(n);
   P.resize(n);
 }
 
 bool TimeSeries::consistent() const {
   const std::size_t n = t.size();
-  for (const auto* c : {&D12, &L1, &L2, &theta, &tau_min, &volume, &area, &bending_energy, &max_bending_moment})
+  for (const auto* c : {&D12, &L1, &L2, &theta, &tau_min, &volume, &area, &bending_energy, &max_bending_moment, &axis_x1,
+                        &axis_x2, &axis_x3, &axis_tilt, &axis_azimuth})
     if (c->size() != n) return false;
   return P.size() == n;
 }

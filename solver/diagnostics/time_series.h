@@ -25,6 +25,11 @@ struct StepRecord {
   std::array<double, 3> P{};  ///< position of the material point P
   double bending_energy = 0;      ///< W_b, units Gs ℓ² (0 without bending stiffness)
   double max_bending_moment = 0;  ///< max κ_b |c − c0| over the surface, units Gs ℓ (0 without bending)
+  /// The material axis: the unit vector from the node that started at the −x1 pole of the unrotated spheroid to
+  /// the one that started at its +x1 pole (mesh.pole_node), i.e. the axis of revolution carried by the membrane.
+  std::array<double, 3> axis{};
+  double axis_tilt = 0;     ///< angle of the material axis out of the shear plane, asin |axis_3|, degrees [0, 90]
+  double axis_azimuth = 0;  ///< angle of its projection on the shear plane from x1 toward x2, as a line: (−90, 90] degrees
 };
 
 /// @brief Measure everything but τmin (which the membrane provides) on positions x at time t.
@@ -32,12 +37,21 @@ struct StepRecord {
 StepRecord measure_step(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x, double t, int p_node,
                         double tau_min);
 
+/// @brief The material axis's direction, tilt and azimuth (StepRecord::axis, axis_tilt, axis_azimuth) on positions
+/// x, from the mesh's pole nodes; {NaN...} if the mesh has none or the two poles coincide.
+struct MaterialAxis {
+  std::array<double, 3> axis{};
+  double tilt = 0, azimuth = 0;
+};
+MaterialAxis material_axis(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x);
+
 /// @brief Column-wise time series of StepRecord (ready for std::span analysis and for HDF5 datasets).
 /// Invariant: every column has size() entries.
 struct TimeSeries {
   std::vector<double> t, D12, L1, L2, theta, tau_min, volume, area;
   std::vector<std::array<double, 3>> P;
   std::vector<double> bending_energy, max_bending_moment;
+  std::vector<double> axis_x1, axis_x2, axis_x3, axis_tilt, axis_azimuth;
 
   /// @brief Append one record.
   void push_back(const StepRecord& r);
@@ -54,5 +68,10 @@ struct TimeSeries {
   /// @brief Bitwise equality of all columns.
   friend bool operator==(const TimeSeries&, const TimeSeries&) = default;
 };
+
+/// @brief The final tilt of a case (summary final_tilt, degrees): the time mean of axis_tilt (trapezoidal, linear
+/// between samples) over [t_begin, t_end] (the last period) when t_begin < t_end, else the last value; NaN for an
+/// empty series.
+double final_tilt(const TimeSeries& series, double t_begin, double t_end);
 
 }  // namespace capsim::diagnostics

@@ -309,6 +309,11 @@ class CaseRun {
     const dynamics::SecondKindStatistics gmres = gmres_statistics();
     r_.gmres_iterations_mean = gmres.mean_iterations();
     r_.gmres_iterations_max = gmres.max_iterations;
+    if (!series_.empty()) {
+      const bool period = !r_.analysis.periods.empty();
+      r_.final_tilt = diagnostics::final_tilt(series_, period ? r_.analysis.periods.front().t_begin : t_,
+                                              period ? r_.analysis.periods.front().t_end : t_);
+    }
     r_.case_file = case_file_;
   }
 

@@ -69,6 +69,9 @@ struct CaseResult {
   /// maximum over the case (all invocations); 0 at λ = 1.
   double gmres_iterations_mean = 0;
   int gmres_iterations_max = 0;
+  /// Tilt of the material axis out of the shear plane (degrees, diagnostics::final_tilt): its time mean over the
+  /// last period found, else its last value. 0 for every in-plane case (the mirror keeps the axis in the plane).
+  double final_tilt = 0;
   std::filesystem::path case_file;
 };
 

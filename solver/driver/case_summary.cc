@@ -67,6 +67,7 @@ const NumberField kNumberFields[] = {
     CAPSIM_SUMMARY_NUMBER(stokes_s, stokes_s),
     CAPSIM_SUMMARY_NUMBER(gmres_iterations_mean, gmres_iterations_mean),
     CAPSIM_SUMMARY_NUMBER(gmres_iterations_max, gmres_iterations_max),
+    CAPSIM_SUMMARY_NUMBER(final_tilt, final_tilt),
 };
 #undef CAPSIM_SUMMARY_NUMBER
 
@@ -146,6 +147,7 @@ CaseSummary CaseSummary::of(const config::CaseConfig& config, const CaseResult& 
   s.stokes_s = r.stokes_s;
   s.gmres_iterations_mean = r.gmres_iterations_mean;
   s.gmres_iterations_max = r.gmres_iterations_max;
+  s.final_tilt = r.final_tilt;
   s.threads = omp_get_max_threads();
   s.case_file = r.case_file.empty() ? std::string() : std::filesystem::absolute(r.case_file).string();
   s.code_version = kGitCommit;

@@ -57,6 +57,7 @@ struct CaseSummary {
   double dt = 0, t_final = 0, wall_s = 0;
   double membrane_s = 0, load_s = 0, stokes_s = 0;  ///< wall time of the phases (CaseResult)
   double gmres_iterations_mean = 0, gmres_iterations_max = 0;  ///< viscosity-ratio solve (CaseResult; 0 at λ = 1)
+  double final_tilt = 0;  ///< degrees, CaseResult::final_tilt (NaN when read from a result from before it)
   int threads = 0;
   std::string case_file;  ///< absolute path of case.h5
   std::string code_version;    ///< git commit of the build

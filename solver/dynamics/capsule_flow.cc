@@ -20,6 +20,10 @@ CapsuleFlow::CapsuleFlow(const config::CaseConfig& c) : Ca_(c.capillary_number),
   c.validate();
   mesh_ = std::make_unique<mesh::SurfaceMesh>(
       mesh::make_capsule_mesh(c.level, c.aspect_ratio, mesh::parse_spheroid_map(c.spheroid_map)));
+  // capsule.tilt / capsule.azimuth: the reference (stress-free) shape is the rotated spheroid, so the membrane
+  // and bending references below are built on it and the initial state (reference()) starts from it. At 0, 0
+  // the mesh is not touched (bitwise the in-plane cases); off the plane it loses its mirror map (see there).
+  mesh::orient_capsule_mesh(*mesh_, c.tilt, c.azimuth);
   law_ = membrane::make_law(c.law, c.skalak_C);
   mechanics_ = std::make_unique<membrane::MembraneMechanics>(*mesh_, mesh_->nodes, *law_,
                                                              membrane::MembraneMechanics::Options{c.membrane_degree});

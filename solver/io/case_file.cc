@@ -22,8 +22,10 @@ struct Column {
   const char* name;
   const char* units;
   std::vector<double> diagnostics::TimeSeries::*member;
-  bool optional = false;  // added later: a file without it reads as zeros
+  bool optional = false;  // added later: a file without it reads as `absent`
+  double absent = 0.0;    // what an optional column reads as in a file from before it
 };
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr Column kColumns[] = {
     {"t", "1/shear_rate", &diagnostics::TimeSeries::t},
     {"D12", "1", &diagnostics::TimeSeries::D12},
@@ -35,6 +37,13 @@ constexpr Column kColumns[] = {
     {"area", "l^2", &diagnostics::TimeSeries::area},
     {"bending_energy", "Gs*l^2", &diagnostics::TimeSeries::bending_energy, true},
     {"max_bending_moment", "Gs*l", &diagnostics::TimeSeries::max_bending_moment, true},
+    // The material axis (solver/README.md, Orientation). A file from before it holds an in-plane case, whose axis
+    // stayed exactly in the plane (the mirror kept bitwise): tilt 0; its direction was not recorded: NaN.
+    {"axis_x1", "1", &diagnostics::TimeSeries::axis_x1, true, kNaN},
+    {"axis_x2", "1", &diagnostics::TimeSeries::axis_x2, true, kNaN},
+    {"axis_x3", "1", &diagnostics::TimeSeries::axis_x3, true, kNaN},
+    {"axis_tilt", "deg", &diagnostics::TimeSeries::axis_tilt, true, 0.0},
+    {"axis_azimuth", "deg", &diagnostics::TimeSeries::axis_azimuth, true, kNaN},
 };
 
 std::string ts(const char* col) { return std::string("timeseries/") + col; }
@@ -337,7 +346,10 @@ CaseFileContents read_case_file(const std::filesystem::path& file) {
   for (const auto& col : kColumns) {
     auto& v = c.series.*col.member;
     v.assign(n, 0.0);
-    if (col.optional && !h5::exists(f.get(), ts(col.name))) continue;
+    if (col.optional && !h5::exists(f.get(), ts(col.name))) {
+      v.assign(n, col.absent);
+      continue;
+    }
     h5::read_dataset(f.get(), ts(col.name), n, v.data(), file);
   }
   c.series.P.resize(n);

@@ -2,6 +2,8 @@
 
 #include <bit>
 #include <cstring>
+#include <iterator>
+#include <limits>
 #include <span>
 #include <stdexcept>
 
@@ -21,8 +23,10 @@ constexpr auto kFixed = h5::StringStorage::Fixed;
 struct Column {
   const char* name;
   std::vector<double> diagnostics::TimeSeries::*member;
-  bool optional = false;  // added later: a checkpoint without it reads as zeros, hashed without it
+  bool optional = false;  // added later: a checkpoint without it reads as `absent`, hashed without it
+  double absent = 0.0;
 };
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr Column kColumns[] = {
     {"t", &diagnostics::TimeSeries::t},           {"D12", &diagnostics::TimeSeries::D12},
     {"L1", &diagnostics::TimeSeries::L1},         {"L2", &diagnostics::TimeSeries::L2},
@@ -30,6 +34,12 @@ constexpr Column kColumns[] = {
     {"volume", &diagnostics::TimeSeries::volume}, {"area", &diagnostics::TimeSeries::area},
     {"bending_energy", &diagnostics::TimeSeries::bending_energy, true},
     {"max_bending_moment", &diagnostics::TimeSeries::max_bending_moment, true},
+    // The material axis; what a checkpoint from before it reads as: as in case_file.cc.
+    {"axis_x1", &diagnostics::TimeSeries::axis_x1, true, kNaN},
+    {"axis_x2", &diagnostics::TimeSeries::axis_x2, true, kNaN},
+    {"axis_x3", &diagnostics::TimeSeries::axis_x3, true, kNaN},
+    {"axis_tilt", &diagnostics::TimeSeries::axis_tilt, true, 0.0},
+    {"axis_azimuth", &diagnostics::TimeSeries::axis_azimuth, true, kNaN},
 };
 
 std::string ts(const char* col) { return std::string("timeseries/") + col; }
@@ -55,8 +65,10 @@ class Fnv1a {
   std::uint64_t h_ = 0xcbf29ce484222325ULL;
 };
 
-// with_optional = false: the checksum of a checkpoint written before the optional columns existed.
-std::uint64_t checksum(const Checkpoint& c, bool with_optional = true) {
+// absent: the optional columns a checkpoint written before them lacks (each was added later, so each has its own
+// bit: a checkpoint with the bending columns but not the axis ones was hashed over the former only). Columns are
+// indexed in kColumns order; absent = 0 is the checksum of a checkpoint with every column.
+std::uint64_t checksum(const Checkpoint& c, std::uint64_t absent = 0) {
   Fnv1a h;
   h.value(static_cast<std::uint64_t>(c.positions.cols()));
   h.bytes(c.positions.data(), sizeof(double) * static_cast<std::size_t>(c.positions.size()));
@@ -64,8 +76,9 @@ std::uint64_t checksum(const Checkpoint& c, bool with_optional = true) {
   h.value(c.step);
   h.value(c.dt);
   h.value(static_cast<std::uint64_t>(c.series.size()));
-  for (const auto& col : kColumns) {
-    if (col.optional && !with_optional) continue;
+  for (std::size_t k = 0; k < std::size(kColumns); ++k) {
+    const auto& col = kColumns[k];
+    if (col.optional && (absent >> k & 1U)) continue;
     const auto& v = c.series.*col.member;
     h.bytes(v.data(), sizeof(double) * v.size());
   }
@@ -153,11 +166,12 @@ Checkpoint read_checkpoint(const std::filesystem::path& file) {
   h5::read_dataset(id, "positions", 3 * static_cast<std::size_t>(num_nodes), c.positions.data(), file);
 
   const auto n = static_cast<std::size_t>(num_records);
-  bool has_optional = true;
-  for (const auto& col : kColumns) {
+  std::uint64_t absent = 0;
+  for (std::size_t k = 0; k < std::size(kColumns); ++k) {
+    const auto& col = kColumns[k];
     if (col.optional && !h5::exists(id, ts(col.name))) {
-      (c.series.*col.member).assign(n, 0.0);
-      has_optional = false;
+      (c.series.*col.member).assign(n, col.absent);
+      absent |= std::uint64_t{1} << k;
       continue;
     }
     const auto d = h5::dataset_dims(id, ts(col.name), file);
@@ -187,7 +201,7 @@ Checkpoint read_checkpoint(const std::filesystem::path& file) {
     }
   }
   f.close(file, "cannot close checkpoint");
-  if (checksum(c, has_optional) != stored_sum) throw IoError(file, "checkpoint is corrupt (checksum mismatch)");
+  if (checksum(c, absent) != stored_sum) throw IoError(file, "checkpoint is corrupt (checksum mismatch)");
   return c;
 }
 

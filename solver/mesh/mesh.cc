@@ -194,6 +194,10 @@ SurfaceMesh make_sphere_mesh(int level) {
   build_adjacency(m);
   build_mirror(m);
   build_central(m);
+  // The poles: the two nodes exactly on the x1 axis (normalised mid-points of (±φ, 0, ±1), bitwise (±1, 0, 0)).
+  for (int i = 0; i < m.num_nodes(); ++i)
+    if (m.nodes(1, i) == 0.0 && m.nodes(2, i) == 0.0) m.pole_node[m.nodes(0, i) > 0.0 ? 0 : 1] = i;
+  if (m.pole_node[0] < 0 || m.pole_node[1] < 0) throw std::logic_error("mesh: no node on the x1 axis");
   return m;
 }
 
@@ -222,6 +226,51 @@ SurfaceMesh make_capsule_mesh(int level, double aspect_ratio, SpheroidMap map) {
     m.nodes(2, i) *= s;
   }
   return m;
+}
+
+namespace {
+// sin and cos of an angle in degrees, exact at the multiples of 90° (std::sin(π/2 rad) is fine, but std::cos of
+// it is 6e-17, which would tilt an axis meant to lie along x3 or in the plane by that much).
+std::array<double, 2> sin_cos_deg(double deg) {
+  const double q = deg / 90.0;
+  if (q == std::round(q)) {
+    static constexpr double kSin[4] = {0.0, 1.0, 0.0, -1.0};
+    const int k = static_cast<int>(((static_cast<long long>(q) % 4) + 4) % 4);
+    return {kSin[k], kSin[(k + 1) % 4]};
+  }
+  const double r = deg * std::numbers::pi / 180.0;
+  return {std::sin(r), std::cos(r)};
+}
+}  // namespace
+
+Eigen::Vector3d axis_of_orientation(double tilt_deg, double azimuth_deg) {
+  return orientation_rotation(tilt_deg, azimuth_deg).col(0);
+}
+
+Eigen::Matrix3d orientation_rotation(double tilt_deg, double azimuth_deg) {
+  if (!std::isfinite(tilt_deg) || !std::isfinite(azimuth_deg))
+    throw std::invalid_argument("mesh: orientation angles must be finite");
+  const auto [st, ct] = sin_cos_deg(tilt_deg);
+  const auto [sp, cp] = sin_cos_deg(azimuth_deg);
+  Eigen::Matrix3d r;
+  r << ct * cp, -sp, -st * cp,  //
+      ct * sp, cp, -st * sp,    //
+      st, 0.0, ct;
+  return r;
+}
+
+void orient_capsule_mesh(SurfaceMesh& m, double tilt_deg, double azimuth_deg) {
+  if (!std::isfinite(tilt_deg) || !std::isfinite(azimuth_deg))
+    throw std::invalid_argument("mesh: orientation angles must be finite");
+  if (tilt_deg == 0.0 && azimuth_deg == 0.0) return;  // the unrotated mesh, bitwise
+  const Eigen::Matrix3d r = orientation_rotation(tilt_deg, azimuth_deg);
+  // Written out per component, in one fixed order, so that a node and its central image (bitwise −x on the
+  // sphere, −x to round-off on the spheroid) get images that are negated in the same way.
+  for (int i = 0; i < m.num_nodes(); ++i) {
+    const double x = m.nodes(0, i), y = m.nodes(1, i), z = m.nodes(2, i);
+    for (int k = 0; k < 3; ++k) m.nodes(k, i) = r(k, 0) * x + r(k, 1) * y + r(k, 2) * z;
+  }
+  if (tilt_deg != 0.0) m.mirror_node.clear();
 }
 
 MeshQuality mesh_quality(const SurfaceMesh& m) {

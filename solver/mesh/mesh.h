@@ -52,6 +52,10 @@ struct SurfaceMesh {
   /// central_node[central_node[i]] == i. Built bitwise on the sphere; the spheroid map keeps it to round-off
   /// (it maps the polar angles θ and π − θ independently), which is why every use of it has a tolerance.
   std::vector<int> central_node;
+  /// The two nodes on the revolution axis of the sphere and spheroid meshes, at +x1 and −x1 before any rotation
+  /// (the mid-side nodes of the icosahedron's edges (φ, 0, ±1) and (−φ, 0, ±1), exactly (±1, 0, 0) on the sphere):
+  /// the material axis of the orientation diagnostics runs from pole_node[1] to pole_node[0]. −1 if absent.
+  std::array<int, 2> pole_node{-1, -1};
   /// Subdivision level of the icosahedron (0..6).
   int level = 0;
 
@@ -71,6 +75,30 @@ std::array<double, 2> spheroid_semi_axes(double aspect_ratio);
 /// @brief The capsule's reference mesh: the sphere mesh of `level` mapped to the spheroid a/b =
 /// aspect_ratio (revolution axis x1) with the given map. aspect_ratio = 1 gives the unit sphere.
 SurfaceMesh make_capsule_mesh(int level, double aspect_ratio, SpheroidMap map = SpheroidMap::EqualArcLength);
+
+/// @brief The unit vector of an axis with tilt `tilt_deg` out of the plane (x1, x2) and azimuth `azimuth_deg` of
+/// its projection from x1 toward x2 (capsule.tilt, capsule.azimuth): (cos t cos φ, cos t sin φ, sin t). Sines and
+/// cosines of multiples of 90° are exact (0, ±1), so an axis at tilt 90 is exactly e3.
+Eigen::Vector3d axis_of_orientation(double tilt_deg, double azimuth_deg);
+
+/// @brief The rotation that puts the capsule's revolution axis e1 on axis_of_orientation(tilt, azimuth):
+/// R = Rz(φ) · R2(t), first a turn by t about −x2 (e1 → (cos t, 0, sin t), e2 fixed), then by φ about x3. Its
+/// columns are the images of e1, e2, e3; e2 stays in the shear plane. Which rotation about the axis itself is
+/// chosen is immaterial for the exact spheroid and fixes how its mesh (not exactly axisymmetric) is placed.
+Eigen::Matrix3d orientation_rotation(double tilt_deg, double azimuth_deg);
+
+/// @brief Rotates the capsule mesh rigidly to the orientation (tilt, azimuth), in degrees: every node x ↦ R x
+/// (orientation_rotation). With tilt = azimuth = 0 nothing is touched at all (no multiplication by the
+/// identity), so the unrotated mesh stays bitwise what it was. The maps:
+/// - central_node stays valid for any rotation, exactly: (R x) → −(R x) is x → −x, and R(−x) is bitwise −(R x)
+///   (every product and sum changes sign exactly).
+/// - mirror_node (x3 → −x3) stays valid at tilt 0 (a turn about x3 leaves x3 bitwise alone); at any other tilt it
+///   is cleared (empty): it no longer maps the scene onto itself, and without it nothing tests or imposes the
+///   mirror (is_mirror_symmetric is false, symmetrise skips it, the boundary integral takes the general path).
+///   At tilt 90 the scene has the mirror again, but its map would be x1 → −x1 of the unrotated spheroid, which
+///   the spheroid map keeps only to round-off; not built (such a scene pays the general path's cost).
+/// @throws std::invalid_argument for angles that are not finite.
+void orient_capsule_mesh(SurfaceMesh& mesh, double tilt_deg, double azimuth_deg);
 
 /// @brief Element-shape statistics of the flat vertex triangles.
 struct MeshQuality {

@@ -109,5 +109,29 @@ TEST(CaseConfig, ViscosityRatioDefaultsToOneAndIsRangeChecked) {
   }
 }
 
+// capsule.tilt and capsule.azimuth: degrees, 0 by default (the in-plane cases, left out of their identities), tilt
+// in [0, 90] and azimuth in (−90, 90] (the axis is a line and the flow has the mirror x3 → −x3: case_keys.def).
+TEST(CaseConfig, OrientationDefaultsToTheShearPlaneAndIsRangeChecked) {
+  const CaseConfig d = parse_case_config("", "empty");
+  EXPECT_EQ(d.tilt, 0.0);
+  EXPECT_EQ(d.azimuth, 0.0);
+  const CaseConfig c = parse_case_config("[capsule]\ntilt = 30\nazimuth = -45.5\n", "case.toml");
+  EXPECT_EQ(c.tilt, 30.0);
+  EXPECT_EQ(c.azimuth, -45.5);
+  EXPECT_EQ(parse_case_config("", "case.toml", {"capsule.tilt=90"}).tilt, 90.0);
+  EXPECT_EQ(parse_case_config("", "case.toml", {"capsule.azimuth=90"}).azimuth, 90.0);
+  for (const char* bad : {"capsule.tilt=-1", "capsule.tilt=90.5", "capsule.tilt=nan", "capsule.tilt=inf",
+                          "capsule.tilt=\"steep\"", "capsule.azimuth=-90", "capsule.azimuth=180",
+                          "capsule.azimuth=nan", "capsule.azimuth=\"x1\""}) {
+    try {
+      (void)parse_case_config("", "case.toml", {bad});
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const ConfigError& e) {
+      const std::string key = std::string(bad).substr(0, std::string(bad).find('='));
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace capsim::config

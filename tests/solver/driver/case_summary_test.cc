@@ -37,6 +37,7 @@ CaseSummary example() {
   s.code_version = "abc";
   s.solver_version = "2";
   s.kernel_isa = "avx2";
+  s.final_tilt = 12.5;
   return s;
 }
 
@@ -56,6 +57,7 @@ TEST(CaseSummary, JsonRoundTripKeepsEveryField) {
   EXPECT_EQ(t.wrinkle_max.wrinkle_wavelength, 0.7);
   EXPECT_EQ(t.wrinkle_max.wrinkle_amplitude, 2e-3);
   EXPECT_EQ(t.kernel_isa, "avx2");
+  EXPECT_EQ(t.final_tilt, 12.5);
 }
 
 // A result line from before kernel_isa existed still reads (the committed databases hold thousands).

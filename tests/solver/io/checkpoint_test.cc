@@ -37,7 +37,8 @@ Checkpoint sample_checkpoint(int nodes = 642, int records = 777) {
   c.dt = 1.0 / 3.0;
   for (int i = 0; i < records; ++i)
     c.series.push_back(
-        {0.01 * i, u(rng), u(rng), u(rng), u(rng), u(rng), u(rng), u(rng), {u(rng), u(rng), u(rng)}, u(rng), u(rng)});
+        {0.01 * i, u(rng), u(rng), u(rng), u(rng), u(rng), u(rng), u(rng), {u(rng), u(rng), u(rng)}, u(rng), u(rng),
+         {u(rng), u(rng), u(rng)}, u(rng), u(rng)});
   c.scalars = {{"p_node", 17}, {"initial volume", 4.18879020478639}, {"a/b", 2.0}, {"tiny", 1e-300}};
   c.strings = {{"case_id", "Ca=0.3 r=2 skalak L3"}, {"unicode", "τmin ≥ 0"}};
   return c;
@@ -217,6 +218,12 @@ TEST(Checkpoint, CheckpointFromBeforeTheBendingColumnsReads) {
   ASSERT_GT(c.series.size(), 0u);
   EXPECT_TRUE(c.series.consistent());
   for (std::size_t i = 0; i < c.series.size(); ++i) EXPECT_EQ(c.series.bending_energy[i], 0.0);
+  // Nor the material axis: an in-plane case (tilt exactly 0), its direction unrecorded (NaN).
+  for (std::size_t i = 0; i < c.series.size(); ++i) {
+    EXPECT_EQ(c.series.axis_tilt[i], 0.0);
+    EXPECT_TRUE(std::isnan(c.series.axis_azimuth[i]));
+    EXPECT_TRUE(std::isnan(c.series.axis_x1[i]));
+  }
   EXPECT_EQ(c.step, 5);
   // Written again by this code, it has the columns and reads back bitwise.
   const auto file = scratch("pre_bending_rewritten.h5");

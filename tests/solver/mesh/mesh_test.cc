@@ -4,6 +4,9 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <memory>
+#include <numbers>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -234,6 +237,91 @@ TEST(CapsuleMesh, SymmetriseWithCentralProjectsOntoTheSymmetryGroup) {
   EXPECT_TRUE(is_centrally_symmetric(m, z, 0.0));
   EXPECT_FALSE(is_mirror_symmetric(m, z, 1e-10));
   for (int i = 0; i < z.cols(); ++i) EXPECT_NEAR(z(2, i), x(2, i) + 1e-6 * x(0, i), 1e-15);
+}
+
+// The poles: one node exactly at each end of the revolution axis, on every level and for every shape.
+TEST(CapsuleMesh, PoleNodesSitOnTheRevolutionAxis) {
+  for (int level = 0; level <= 3; ++level)
+    for (const double r : {0.5, 1.0, 2.0}) {
+      const SurfaceMesh m = make_capsule_mesh(level, r);
+      const double a = spheroid_semi_axes(r)[0];
+      ASSERT_GE(m.pole_node[0], 0);
+      ASSERT_GE(m.pole_node[1], 0);
+      EXPECT_EQ(m.nodes(1, m.pole_node[0]), 0.0);
+      EXPECT_EQ(m.nodes(2, m.pole_node[0]), 0.0);
+      EXPECT_NEAR(m.nodes(0, m.pole_node[0]), a, 1e-15);
+      EXPECT_EQ(m.nodes.col(m.pole_node[1]), (-m.nodes.col(m.pole_node[0])).eval()) << "level " << level << " r " << r;
+    }
+}
+
+// tilt = azimuth = 0 leaves the mesh bitwise alone (every in-plane case keeps its results bit for bit).
+TEST(CapsuleMesh, ZeroOrientationIsBitwiseTheUnrotatedMesh) {
+  const SurfaceMesh ref = make_capsule_mesh(2, 2.0);
+  SurfaceMesh m = make_capsule_mesh(2, 2.0);
+  orient_capsule_mesh(m, 0.0, 0.0);
+  ASSERT_EQ(m.nodes.cols(), ref.nodes.cols());
+  EXPECT_EQ(std::memcmp(m.nodes.data(), ref.nodes.data(), sizeof(double) * ref.nodes.size()), 0);
+  EXPECT_EQ(m.mirror_node, ref.mirror_node);
+  EXPECT_EQ(m.central_node, ref.central_node);
+}
+
+// A rotation puts the +x1 pole at a · (cos t cos φ, cos t sin φ, sin t), is rigid, keeps the point symmetry to the
+// unrotated mesh's round-off, keeps the mirror map only at tilt 0 (where it still holds bitwise) and clears it
+// otherwise.
+TEST(CapsuleMesh, OrientationRotatesThePoleWhereExpected) {
+  const double deg = std::numbers::pi / 180.0;
+  const double a = spheroid_semi_axes(2.0)[0];
+  const SurfaceMesh ref = make_capsule_mesh(2, 2.0);
+  struct Case {
+    double tilt, azimuth;
+  };
+  for (const Case c : {Case{30.0, 0.0}, Case{30.0, 40.0}, Case{0.0, 45.0}, Case{90.0, 0.0}, Case{90.0, 90.0},
+                       Case{12.5, -70.0}, Case{0.0, 90.0}}) {
+    SurfaceMesh m = make_capsule_mesh(2, 2.0);
+    orient_capsule_mesh(m, c.tilt, c.azimuth);
+    const Eigen::Vector3d expected(std::cos(c.tilt * deg) * std::cos(c.azimuth * deg),
+                                   std::cos(c.tilt * deg) * std::sin(c.azimuth * deg), std::sin(c.tilt * deg));
+    const Eigen::Vector3d pole = m.nodes.col(m.pole_node[0]);
+    EXPECT_LT((pole - a * expected).norm(), 1e-14) << c.tilt << " " << c.azimuth << ": " << pole.transpose();
+    EXPECT_LT((axis_of_orientation(c.tilt, c.azimuth) - expected).norm(), 1e-15);
+    EXPECT_EQ(m.nodes.col(m.pole_node[1]), (-m.nodes.col(m.pole_node[0])).eval());
+    // Rigid: every distance from the centre and between neighbours kept to round-off.
+    for (int i = 0; i < m.num_nodes(); ++i) {
+      EXPECT_NEAR(m.nodes.col(i).norm(), ref.nodes.col(i).norm(), 1e-15);
+      const int j = (i + 7) % m.num_nodes();
+      EXPECT_NEAR((m.nodes.col(i) - m.nodes.col(j)).norm(), (ref.nodes.col(i) - ref.nodes.col(j)).norm(), 1e-14);
+    }
+    EXPECT_TRUE(is_centrally_symmetric(m, m.nodes, 1e-12));
+    EXPECT_EQ(m.central_node, ref.central_node);
+    if (c.tilt == 0.0) {
+      EXPECT_TRUE(is_mirror_symmetric(m, m.nodes, 0.0)) << "a turn about x3 keeps x3 bitwise";
+    } else {
+      EXPECT_TRUE(m.mirror_node.empty()) << "tilt " << c.tilt;
+      EXPECT_FALSE(is_mirror_symmetric(m, m.nodes, 1e-12));
+    }
+  }
+  // Exact at the multiples of 90°: the axis of a tilt-90 capsule is e3 with no round-off.
+  EXPECT_EQ(axis_of_orientation(90.0, 0.0), Eigen::Vector3d(0.0, 0.0, 1.0));
+  EXPECT_EQ(axis_of_orientation(0.0, 90.0), Eigen::Vector3d(0.0, 1.0, 0.0));
+  EXPECT_THROW(orient_capsule_mesh(*std::make_unique<SurfaceMesh>(make_capsule_mesh(0, 2.0)), std::nan(""), 0.0),
+               std::invalid_argument);
+}
+
+// symmetrise on a tilted mesh imposes the point symmetry only (it has no mirror map), and changes a centrally
+// symmetric state at round-off level only: it does not drag the tilted capsule back into the plane.
+TEST(CapsuleMesh, SymmetriseLeavesATiltedCapsuleTilted) {
+  SurfaceMesh m = make_capsule_mesh(2, 2.0);
+  orient_capsule_mesh(m, 30.0, 20.0);
+  Eigen::Matrix3Xd x = m.nodes;
+  symmetrise(m, x, /*mirror=*/true, /*central=*/true);
+  // The unrotated spheroid is centrally symmetric only to round-off (the map places θ and π − θ separately), so
+  // the projection moves it by that much; the rotated one by no more.
+  const SurfaceMesh ref = make_capsule_mesh(2, 2.0);
+  Eigen::Matrix3Xd y = ref.nodes;
+  symmetrise(ref, y, /*mirror=*/false, /*central=*/true);
+  const double ref_change = (y - ref.nodes).cwiseAbs().maxCoeff();
+  EXPECT_LE((x - m.nodes).cwiseAbs().maxCoeff(), 2.0 * ref_change + 1e-15) << "unrotated: " << ref_change;
+  EXPECT_TRUE(is_centrally_symmetric(m, x, 0.0));
 }
 
 }  // namespace

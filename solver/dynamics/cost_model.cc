@@ -7,12 +7,23 @@
 namespace capsim::dynamics {
 
 SceneSymmetry CostModel::symmetry(const config::CaseConfig& config) {
+  if (config.tilt != 0.0) return config.central_symmetry ? SceneSymmetry::kCentral : SceneSymmetry::kNone;
   return config.central_symmetry ? SceneSymmetry::kMirrorAndCentral : SceneSymmetry::kMirror;
 }
 
+namespace {
+// The boundary integral's targets and the membrane's elements, as fractions of the whole surface's.
+double target_reduction(SceneSymmetry s) {
+  return s == SceneSymmetry::kNone ? 1.0 : s == SceneSymmetry::kMirrorAndCentral ? 4.0 : 2.0;
+}
+double membrane_reduction(SceneSymmetry s) {
+  return s == SceneSymmetry::kMirrorAndCentral || s == SceneSymmetry::kCentral ? 2.0 : 1.0;
+}
+}  // namespace
+
 double CostModel::evaluation_ms(int level, SceneSymmetry symmetry, bool mixed_precision) {
-  const double targets = symmetry == SceneSymmetry::kNone ? 1.0 : symmetry == SceneSymmetry::kMirror ? 2.0 : 4.0;
-  const double membrane = symmetry == SceneSymmetry::kMirrorAndCentral ? 2.0 : 1.0;
+  const double targets = target_reduction(symmetry);
+  const double membrane = membrane_reduction(symmetry);
   const double sum = kRegularSumMs * std::pow(16.0, level - 3) / (mixed_precision ? kMixedSumSpeedup : 1.0);
   const double per_node = std::pow(4.0, level - 3);
   return sum / targets + (kCorrectionsMs / targets + kMembraneMs / membrane + kRestMs) * per_node;
@@ -31,7 +42,7 @@ double CostModel::double_layer_applications(const config::CaseConfig& config) {
 }
 
 double CostModel::double_layer_ms(int level, SceneSymmetry symmetry) {
-  const double targets = symmetry == SceneSymmetry::kNone ? 1.0 : symmetry == SceneSymmetry::kMirror ? 2.0 : 4.0;
+  const double targets = target_reduction(symmetry);
   return kDoubleLayerPerSingleLayer *
          (kRegularSumMs * std::pow(16.0, level - 3) + kCorrectionsMs * std::pow(4.0, level - 3)) / targets;
 }

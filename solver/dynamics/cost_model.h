@@ -15,6 +15,8 @@ enum class SceneSymmetry {
   kNone,              ///< the general scene: every node a target (a capsule whose axis leaves the shear plane)
   kMirror,            ///< x3 → −x3: half the nodes (every capsule that starts with its axis in the shear plane)
   kMirrorAndCentral,  ///< and x → −x (numerics.central_symmetry): a quarter of the nodes, half the membrane
+  kCentral,           ///< x → −x alone (an axis out of the plane with numerics.central_symmetry): half the nodes,
+                      ///< half the membrane
 };
 
 /// @brief The relative cost of cases, in milliseconds of one thread of the machine of the "Flow evaluation by
@@ -49,9 +51,10 @@ enum class SceneSymmetry {
 /// EtaModel::kCostExponent), and of one case across levels, symmetries and precisions.
 class CostModel {
  public:
-  /// @brief The scene's symmetry as the solver uses it: every scene today starts with its axis in the shear
-  /// plane, so the mirror always holds (the boundary integral detects it), and numerics.central_symmetry adds
-  /// the point symmetry. kNone is for the general scene of orientations out of the plane.
+  /// @brief The scene's symmetry as the solver uses it: a capsule whose axis starts in the shear plane
+  /// (capsule.tilt = 0) has the mirror (the boundary integral detects it), one tilted out of it has not (the mesh
+  /// clears its mirror map, solver/README.md §1b); numerics.central_symmetry adds the point symmetry, which holds
+  /// for every orientation.
   static SceneSymmetry symmetry(const config::CaseConfig& config);
   /// @brief Milliseconds of one flow evaluation on mesh level @p level (the formula of the class comment).
   static double evaluation_ms(int level, SceneSymmetry symmetry, bool mixed_precision);

@@ -68,8 +68,8 @@ TEST(CostModel, MixedPrecisionSavesMoreOnFinerMeshes) {
   }
 }
 
-// The scene's symmetry is what the solver uses: the mirror always (every scene starts in the shear plane), the
-// point symmetry where numerics.central_symmetry asks for it.
+// The scene's symmetry is what the solver uses: the mirror where the axis starts in the shear plane, the point
+// symmetry where numerics.central_symmetry asks for it.
 TEST(CostModel, TheSceneUsesTheSymmetryItsKeysAskFor) {
   config::CaseConfig c;
   EXPECT_EQ(CostModel::symmetry(c), SceneSymmetry::kMirror);
@@ -78,6 +78,12 @@ TEST(CostModel, TheSceneUsesTheSymmetryItsKeysAskFor) {
   EXPECT_EQ(CostModel::evaluation_ms(c), CostModel::evaluation_ms(c.level, SceneSymmetry::kMirrorAndCentral, false));
   c.kernel_precision = "mixed";
   EXPECT_EQ(CostModel::evaluation_ms(c), CostModel::evaluation_ms(c.level, SceneSymmetry::kMirrorAndCentral, true));
+  // An axis out of the shear plane loses the mirror, keeps the point symmetry.
+  c.tilt = 30.0;
+  EXPECT_EQ(CostModel::symmetry(c), SceneSymmetry::kCentral);
+  EXPECT_GT(CostModel::evaluation_ms(c), CostModel::evaluation_ms(c.level, SceneSymmetry::kMirrorAndCentral, true));
+  c.central_symmetry = false;
+  EXPECT_EQ(CostModel::symmetry(c), SceneSymmetry::kNone);
 }
 
 // A case: t_end × the step rule's evaluations per unit time × an evaluation (λ = 1: no double layer). Bending

@@ -5,6 +5,7 @@
 // the seed's Table 1 cell by cell (results/seed_table1.json), as scripts/run prints it. The database is copied
 // first so that nothing can touch the repository's file.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -19,17 +20,19 @@ namespace {
 
 const fs::path kResults = fs::path(CAPSIM_SOURCE_DIR) / "results";
 
-// `capsim query table1` of a scratch copy of results/DB_NAME (of `campaign`, else the latest campaign), after
-// `capsim campaign analyse` when `reanalyse`. Null on failure (the failure is recorded).
-nlohmann::json query_table1(const std::string& db_name, const std::string& campaign, bool reanalyse) {
+// `capsim query table1` of a scratch copy of results/DB_NAME (of `campaign`, else the latest campaign; with the
+// table1 `options`, e.g. one λ), after `capsim campaign analyse` when `reanalyse`. Null on failure (recorded).
+nlohmann::json query_table1(const std::string& db_name, const std::string& campaign, bool reanalyse,
+                            const std::string& options = "") {
   // A committed deliverable: a missing one is a failure, not a reason to skip.
   if (!fs::exists(kResults / db_name)) {
     ADD_FAILURE() << "results/" << db_name << " is missing";
     return {};
   }
   // One scratch folder per database and campaign: ctest -j runs the tests at once.
-  std::string scratch = fs::path(db_name).replace_extension().string() + "_" + campaign;
-  std::replace(scratch.begin(), scratch.end(), '/', '_');
+  std::string scratch = fs::path(db_name).replace_extension().string() + "_" + campaign + options;
+  for (char& ch : scratch)
+    if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '.' && ch != '_') ch = '_';
   const std::string dir = fresh_dir("committed_" + scratch);
   const std::string copy = dir + "/" + fs::path(db_name).filename().string();
   fs::copy_file(kResults / db_name, copy);
@@ -41,7 +44,7 @@ nlohmann::json query_table1(const std::string& db_name, const std::string& campa
       return {};
     }
   }
-  const CmdResult r = sh(exe() + " query table1 --db " + copy + which + " --format json");
+  const CmdResult r = sh(exe() + " query table1 --db " + copy + which + " " + options + " --format json");
   if (r.code != 0) {
     ADD_FAILURE() << "query table1: " << r.err;
     return {};
@@ -56,9 +59,9 @@ double distance_to(double x, double from, double to) { return std::max({from - x
 // change to the analysis moves a committed answer, not only when the JSON lags the stored rows. (The paper
 // preset's database predates today's analysis and is compared as stored: a check of the renderer alone.)
 void expect_query_reproduces(const std::string& db_name, const std::string& json_name, const std::string& campaign = "",
-                             std::size_t rows = 6, bool reanalyse = true) {
+                             std::size_t rows = 6, bool reanalyse = true, const std::string& options = "") {
   ASSERT_TRUE(fs::exists(kResults / json_name)) << "results/" << json_name << " is missing";
-  const auto ours = query_table1(db_name, campaign, reanalyse);
+  const auto ours = query_table1(db_name, campaign, reanalyse, options);
   const auto committed = nlohmann::json::parse(read_file((kResults / json_name).string()));
   ASSERT_TRUE(ours.is_array());
   EXPECT_EQ(ours.size(), rows) << "two laws x three aspect ratios, or the cells the campaign has";
@@ -147,6 +150,14 @@ TEST(CommittedResults, StifferBendingTableIsWhatTheDatabaseGives) {
 TEST(CommittedResults, OblateTransitionAtSmallBendingIsWhatTheDatabaseGives) {
   expect_query_reproduces("bending/oblate_regime.sqlite", "bending/oblate_regime_kb1e-4.json",
                           "bending-oblate-regime-1e-4", 1);
+}
+
+// The viscosity-ratio study (results/viscosity_ratio/README.md): each λ's Table 1 as committed.
+TEST(CommittedResults, ViscosityRatioStudyTablesAreWhatThisBuildComputesFromItsDatabase) {
+  for (const char* lambda : {"0.2", "1", "5"})
+    expect_query_reproduces("viscosity_ratio/viscosity_ratio.sqlite",
+                            std::string("viscosity_ratio/table1_lambda") + lambda + ".json", "", 6, true,
+                            std::string("--viscosity-ratio ") + lambda);
 }
 
 }  // namespace

@@ -193,6 +193,26 @@ TEST_F(ScriptsTest, PlotsTable1AgainstTheBendingModulus) {
   EXPECT_NE(bad.err.find("junk_table1.json"), std::string::npos) << bad.err;
 }
 
+// Figure 7 (the viscosity ratio) from the committed λ study: a figure and a table with a row per law × a/b × λ; a
+// database of one λ is refused with one message (exit 2), as the figure needs a viscosity_ratio axis.
+TEST_F(ScriptsTest, PlotsTheViscosityRatioFigureFromTheCommittedStudy) {
+  const auto out = dir_ / "fig7";
+  fs::remove_all(out);
+  const auto db = fs::path(kSrc) / "results/viscosity_ratio/viscosity_ratio.sqlite";
+  ASSERT_TRUE(fs::exists(db)) << "the committed study is a deliverable";
+  fs::create_directories(out);
+  fs::copy_file(db, out / "study.sqlite");  // queried read-only, but not in the source tree
+  const Cmd r = sh(plot() + " --db " + q(out / "study.sqlite") + " --only 7 --out " + q(out));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(is_png(out / "viscosity_ratio_figure7.png"));
+  const std::string table = slurp(out / "viscosity_ratio_table.md");
+  EXPECT_EQ(count_lines(table), 2 + 2 * 3 * 3) << table;  // header, rule, 2 laws × 3 a/b × 3 λ
+  for (const char* lam : {"| 0.2 |", "| 1 |", "| 5 |"}) EXPECT_NE(table.find(lam), std::string::npos) << lam;
+  const Cmd one = sh(plot() + " --db " + q(dir_ / "fixture.sqlite") + " --only 7 --out " + q(out / "one"));
+  EXPECT_EQ(one.code, 2) << one.err;
+  EXPECT_NE(one.err.find("one viscosity ratio only"), std::string::npos) << one.err;
+}
+
 TEST_F(ScriptsTest, Table1FromTheDatabaseComparesCellByCell) {
   const auto md = dir_ / "table1.md";
   fs::remove(md);

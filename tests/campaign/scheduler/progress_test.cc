@@ -325,12 +325,13 @@ TEST(EtaModel, TheMainCommandsEtaIsGoodToThirtyPercent) {
     double est = 0, wall = 0, created = 0, started = 0, finished = 0, est_below = 0;
   };
   std::vector<Case> cases;
-  // Seconds from the start of the run day (julianday keeps a millisecond: 1e-10 of a day in 2.46e6 days).
+  // Seconds from the first case's registration (julianday keeps a millisecond: 1e-10 of a day in 2.46e6 days);
+  // only differences of these times are used.
   Stmt s(store->db(),
-         "SELECT c.params_json, r.wall_s, (julianday(c.created_at) - julianday('2026-12-06')) * 86400, "
-         "(julianday(c.started_at) - julianday('2026-12-06')) * 86400, "
-         "(julianday(c.finished_at) - julianday('2026-12-06')) * 86400 "
-         "FROM cases c JOIN results r ON r.case_id=c.case_id ORDER BY c.created_at, c.case_id");
+         "WITH origin AS (SELECT min(julianday(created_at)) AS d FROM cases) "
+         "SELECT c.params_json, r.wall_s, (julianday(c.created_at) - origin.d) * 86400, "
+         "(julianday(c.started_at) - origin.d) * 86400, (julianday(c.finished_at) - origin.d) * 86400 "
+         "FROM cases c JOIN results r ON r.case_id=c.case_id, origin ORDER BY c.created_at, c.case_id");
   while (s.step()) {
     Case c{CaseParams::from_json(s.text(0)), 0, *s.real(1), *s.real(2), *s.real(3), *s.real(4)};
     c.est = c.params.estimated_cost();

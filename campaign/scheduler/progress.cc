@@ -57,11 +57,12 @@ double EtaModel::carried_log(int mesh_level, double x, double x_below, bool coar
       nearest = level, found = true;
   if (!found) return std::nan("");
   // The case itself, where its estimate on the level below is known and that level is the nearest one.
-  if (nearest == mesh_level - 1 && std::isfinite(x_below)) return law_log(nearest, x_below, std::nan("")) + (x - x_below);
+  if (nearest == mesh_level - 1 && std::isfinite(x_below))
+    return law_log(nearest, x_below, std::nan("")) + (x - x_below) + std::log(kFinerLevelCarry);
   // Else at that level's mean ratio of wall to estimate (its prediction at its mean estimate, moved in
-  // proportion).
+  // proportion). Either way times kFinerLevelCarry per level finer (its inverse per level coarser).
   const double mx = by_level_.at(nearest).x / by_level_.at(nearest).n;
-  return law_log(nearest, mx, std::nan("")) + (x - mx);
+  return law_log(nearest, mx, std::nan("")) + (x - mx) + (mesh_level - nearest) * std::log(kFinerLevelCarry);
 }
 
 double EtaModel::law_log(int mesh_level, double x, double x_below) const {
@@ -98,20 +99,23 @@ double EtaModel::remaining_s(const std::vector<Work>& cases, int jobs, const std
       longest_case = std::max(longest_case, e);
     }
   }
-  // What refinement will still add: the rounds per cell drawn towards this campaign's settled cells.
-  double rounds_per_cell = kPriorCells * kAnswerRoundsPerCell, weight = kPriorCells;
+  // What refinement will still add: the rounds and cases per cell drawn towards this campaign's settled cells.
+  double rounds_per_cell = kPriorCells * kAnswerRoundsPerCell, cases_per_cell = kPriorCells * kAnswerCasesPerCell;
+  double weight = kPriorCells;
   for (const auto& [_, c] : cells)
     if (c.settled) {
       rounds_per_cell += c.answer_rounds;
+      cases_per_cell += c.answer_cases;
       weight += 1;
     }
   rounds_per_cell /= weight;
+  cases_per_cell /= weight;
   for (const auto& [key, c] : cells) {
     if (c.settled) continue;
     const double e = expected_s(c.answer_level, c.answer_est_cost, c.answer_est_cost_below);
     if (!(e > 0)) continue;
     const double rounds_to_come = std::max(0.0, rounds_per_cell - c.answer_rounds);
-    const double cases_to_come = c.answer_rounds > 0 ? rounds_to_come * kCasesPerLaterRound : kAnswerCasesPerCell;
+    const double cases_to_come = c.answer_rounds > 0 ? rounds_to_come * kCasesPerLaterRound : cases_per_cell;
     total += cases_to_come * e;
     const auto it = round_left.find(key);
     const double current = it == round_left.end() ? 0.0 : std::max(it->second.first / jobs, it->second.second);

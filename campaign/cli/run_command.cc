@@ -94,6 +94,11 @@ int run_command(const std::vector<std::string>& args) {
     std::fprintf(stderr, "# regime %s  period %.4g  min_D12 %.5f  max_tau_min %+.5f  mean_D12 %.5f  volume drift %.2e\n",
                  std::string(diagnostics::to_string(a.regime)).c_str(), a.period, a.min_D12, a.max_tau_min,
                  a.mean_D12, r.volume_drift);
+    if (config.tilt != 0.0 || r.final_tilt != 0.0)  // a case off the plane (an in-plane one prints as before)
+      std::fprintf(stderr,
+                   "# orientation: started at tilt %.4g deg, azimuth %.4g deg; final tilt %.4g deg, tilt growth rate "
+                   "%+.4g +- %.2g per unit shear time\n",
+                   config.tilt, config.azimuth, r.final_tilt, r.tilt_growth_rate, r.tilt_growth_rate_error);
     std::fprintf(stderr, "# phases: membrane %.1f s, load %.1f s, boundary integral %.1f s\n", r.membrane_s, r.load_s,
                  r.stokes_s);
     std::fprintf(stderr,

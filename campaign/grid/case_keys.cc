@@ -31,6 +31,8 @@ const std::vector<std::pair<std::string, std::string>>& axis_aliases() {
       {"mesh_level", "mesh.level"},
       {"bending_modulus", "capsule.bending_modulus"},
       {"viscosity_ratio", "flow.viscosity_ratio"},
+      {"tilt", "capsule.tilt"},
+      {"azimuth", "capsule.azimuth"},
   };
   return aliases;
 }

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <variant>
 
 #include "campaign/analysis/group_key.h"
 #include "campaign/common/bad_input.h"
@@ -17,6 +18,7 @@
 #include "capsim/schema_sql.h"
 #include "capsim/version.h"
 #include "solver/config/case_config.h"
+#include "solver/config/case_keys.h"
 #include "solver/driver/case_summary.h"
 
 namespace capsim::campaign {
@@ -748,7 +750,13 @@ Table Store::cases_table(const CaseFilter& f) {
          "c.code_version, c.error, c.h5_path, c.params_json AS params, c.out_dir, r.raw_json AS summary, "
          // λ: stored in params only where set (a case key at its default is left out of the identity).
          "coalesce(json_extract(c.params_json, '$.\"flow.viscosity_ratio\"'), ?7) AS viscosity_ratio, "
-         "json_extract(r.raw_json, '$.gmres_iterations_mean') AS gmres_iterations_mean "
+         "json_extract(r.raw_json, '$.gmres_iterations_mean') AS gmres_iterations_mean, "
+         // The initial orientation (stored in params only where set, as λ) and what the axis ended doing.
+         "coalesce(json_extract(c.params_json, '$.\"capsule.tilt\"'), ?9) AS tilt, "
+         "coalesce(json_extract(c.params_json, '$.\"capsule.azimuth\"'), ?10) AS azimuth, "
+         "json_extract(r.raw_json, '$.final_tilt') AS final_tilt, "
+         "json_extract(r.raw_json, '$.tilt_growth_rate') AS tilt_growth_rate, "
+         "json_extract(r.raw_json, '$.tilt_growth_rate_error') AS tilt_growth_rate_error "
          "FROM cases c LEFT JOIN results r ON r.case_id=c.case_id "
          "WHERE (?1 = '' OR c.case_id IN (SELECT cc.case_id FROM campaign_cases cc JOIN campaigns k "
          "ON k.campaign_id=cc.campaign_id WHERE k.name=?1)) "
@@ -760,6 +768,9 @@ Table Store::cases_table(const CaseFilter& f) {
   const double lambda_default = GroupKey::parse("{}")->viscosity_ratio();  // the key registry's default
   s.bind(1, f.campaign).bind(2, f.law).bind(3, f.aspect_ratio).bind(4, f.ca_min).bind(5, f.ca_max).bind(6, f.status);
   s.bind(7, lambda_default).bind(8, f.viscosity_ratio);
+  // The orientation keys' defaults, from the key registry (a case at its default leaves the key out of params).
+  auto key_default = [](const char* name) { return std::get<double>(config::find_case_key(name)->default_value); };
+  s.bind(9, key_default("capsule.tilt")).bind(10, key_default("capsule.azimuth"));
   Table t = read_table(s);
   t.json_columns = {"summary"};
   return t;

@@ -109,6 +109,10 @@ std::string_view to_string(Regime regime) {
     case Regime::steady: return "steady";
     case Regime::tumbling: return "tumbling";
     case Regime::swinging: return "swinging";
+    case Regime::rolling: return "rolling";
+    case Regime::wobbling: return "wobbling";
+    case Regime::kayaking: return "kayaking";
+    case Regime::oscillating_swinging: return "oscillating-swinging";
     case Regime::unknown: break;
   }
   return "unknown";

@@ -24,15 +24,22 @@
 
 namespace capsim::diagnostics {
 
-/// @brief Motion regime of the capsule (seed §3.1–3.2).
+/// @brief Motion regime of the capsule (seed §3.1–3.2; off the plane, Dupont et al. 2013, 2016).
+/// analyse_periods names the first four from the shape's projection on the shear plane; the off-plane ones are
+/// named by classify_regime (orientation_regime.h) from the material axis's tilt as well.
 enum class Regime {
   unknown,   ///< not enough data for a full period or a stationary window
   steady,    ///< D12 and θ stationary (spherical capsule: steady deformed shape, tank-treading membrane)
   tumbling,  ///< the long axis keeps rotating with the vorticity: θ unwrapped turns through ±π/2 and beyond
   swinging,  ///< the long axis oscillates about a mean inclination while the membrane rotates
+  rolling,   ///< the axis of revolution stays along the vorticity x3 (the membrane tank-treads about it)
+  wobbling,  ///< the axis moves about the vorticity, staying nearer it than the shear plane
+  kayaking,  ///< the axis precesses about the vorticity at an intermediate tilt (an off-plane tumbling)
+  oscillating_swinging,  ///< the projection swings while the axis oscillates out of the shear plane
 };
 
-/// @brief "unknown" | "steady" | "tumbling" | "swinging".
+/// @brief "unknown" | "steady" | "tumbling" | "swinging" | "rolling" | "wobbling" | "kayaking" |
+/// "oscillating-swinging".
 std::string_view to_string(Regime regime);
 
 /// @brief Tolerances of the stopping test.

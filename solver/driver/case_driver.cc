@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 #include <optional>
 #include <system_error>
 
 #include "solver/diagnostics/material_point.h"
+#include "solver/diagnostics/orientation_regime.h"
 #include "solver/diagnostics/time_series.h"
 #include "solver/driver/case_summary.h"
 #include "solver/driver/snapshot_fields.h"
@@ -160,6 +162,9 @@ class CaseRun {
     next_sample_ = config_.sample_interval > 0 ? at_or_after(config_.sample_interval) : t_;
     next_wrinkle_ = after(kWrinkleInterval);
     convergence_ = diagnostics::stop_test_options(config_.stop_test, config_.period_tolerance);
+    // The tilt is held to the period tolerance taken as an angle (radians, here in degrees): a turn of the axis
+    // by δ moves the capsule's ends by about δ, as a change δ of D12 moves its boundary.
+    tilt_tolerance_ = config_.period_tolerance * 180.0 / std::numbers::pi;
   }
 
   // --- March in time until an interrupt, t_end, a blow-up or a converged periodic regime.
@@ -269,7 +274,10 @@ class CaseRun {
     if (t_ >= next_check_ - eps_) {
       next_check_ += config_.check_interval;
       r_.analysis = diagnostics::analyse_periods(series_);
-      if (diagnostics::periodic_regime_converged(r_.analysis, convergence_)) {
+      // Off the plane the regime must also have repeated with the same tilt (orientation_converged: always true
+      // for an axis in the plane, whose stop is the in-plane test alone).
+      if (diagnostics::periodic_regime_converged(r_.analysis, convergence_) &&
+          diagnostics::orientation_converged(series_, r_.analysis, tilt_tolerance_)) {
         r_.converged = true;
         r_.status = "done";
         return true;
@@ -313,6 +321,12 @@ class CaseRun {
       const bool period = !r_.analysis.periods.empty();
       r_.final_tilt = diagnostics::final_tilt(series_, period ? r_.analysis.periods.front().t_begin : t_,
                                               period ? r_.analysis.periods.front().t_end : t_);
+      const diagnostics::TiltGrowth growth = diagnostics::tilt_growth_rate(series_, r_.analysis);
+      r_.tilt_growth_rate = growth.rate;
+      r_.tilt_growth_rate_error = growth.error;
+      // The published name of what the capsule ends doing: the in-plane regime itself while the axis stays in
+      // the plane (every in-plane case), else rolling, wobbling, kayaking, oscillating-swinging (§5).
+      r_.analysis.regime = diagnostics::classify_regime(series_, r_.analysis);
     }
     r_.case_file = case_file_;
   }
@@ -401,6 +415,7 @@ class CaseRun {
   double dt_ = 0, V0_ = 0, h_min_ = 0, eps_ = 0;
   std::string identity_;
   diagnostics::ConvergenceOptions convergence_;
+  double tilt_tolerance_ = 0;  // degrees, the off-plane part of the stop test
   std::optional<io::CaseWriter> writer_;
 
   // The state a checkpoint carries.

@@ -16,6 +16,7 @@
 #include <atomic>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <string>
 
 #include "solver/config/case_config.h"
@@ -72,6 +73,11 @@ struct CaseResult {
   /// Tilt of the material axis out of the shear plane (degrees, diagnostics::final_tilt): its time mean over the
   /// last period found, else its last value. 0 for every in-plane case (the mirror keeps the axis in the plane).
   double final_tilt = 0;
+  /// Growth rate of the tilt per unit γ̇t and its standard error (diagnostics::tilt_growth_rate over the periods
+  /// of the final analysis): < 0, the capsule returns to the shear plane; NaN in the plane (tilt 0) or with fewer
+  /// than two periods (the error: fewer than three).
+  double tilt_growth_rate = std::numeric_limits<double>::quiet_NaN();
+  double tilt_growth_rate_error = std::numeric_limits<double>::quiet_NaN();
   std::filesystem::path case_file;
 };
 

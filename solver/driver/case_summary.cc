@@ -68,6 +68,8 @@ const NumberField kNumberFields[] = {
     CAPSIM_SUMMARY_NUMBER(gmres_iterations_mean, gmres_iterations_mean),
     CAPSIM_SUMMARY_NUMBER(gmres_iterations_max, gmres_iterations_max),
     CAPSIM_SUMMARY_NUMBER(final_tilt, final_tilt),
+    CAPSIM_SUMMARY_NUMBER(tilt_growth_rate, tilt_growth_rate),
+    CAPSIM_SUMMARY_NUMBER(tilt_growth_rate_error, tilt_growth_rate_error),
 };
 #undef CAPSIM_SUMMARY_NUMBER
 
@@ -106,7 +108,8 @@ diagnostics::Regime regime_of(const std::string& name) {
 }  // namespace
 
 CaseParameters CaseParameters::of(const config::CaseConfig& c) {
-  return {c.capillary_number, c.aspect_ratio, c.law, c.skalak_C, c.level, c.bending_modulus, c.viscosity_ratio};
+  return {c.capillary_number, c.aspect_ratio, c.law,           c.skalak_C, c.level, c.bending_modulus,
+          c.viscosity_ratio,  c.tilt,         c.azimuth};
 }
 
 std::string parameter_mismatch(const CaseParameters& reported, const CaseParameters& expected) {
@@ -123,6 +126,8 @@ std::string parameter_mismatch(const CaseParameters& reported, const CaseParamet
     return "bending_modulus " + text(reported.bending_modulus);
   if (!near(reported.viscosity_ratio, expected.viscosity_ratio))
     return "viscosity_ratio " + text(reported.viscosity_ratio);
+  if (!near(reported.tilt, expected.tilt)) return "tilt " + text(reported.tilt);
+  if (!near(reported.azimuth, expected.azimuth)) return "azimuth " + text(reported.azimuth);
   return "";
 }
 
@@ -148,6 +153,8 @@ CaseSummary CaseSummary::of(const config::CaseConfig& config, const CaseResult& 
   s.gmres_iterations_mean = r.gmres_iterations_mean;
   s.gmres_iterations_max = r.gmres_iterations_max;
   s.final_tilt = r.final_tilt;
+  s.tilt_growth_rate = r.tilt_growth_rate;
+  s.tilt_growth_rate_error = r.tilt_growth_rate_error;
   s.threads = omp_get_max_threads();
   s.case_file = r.case_file.empty() ? std::string() : std::filesystem::absolute(r.case_file).string();
   s.code_version = kGitCommit;
@@ -168,6 +175,8 @@ nlohmann::json CaseSummary::to_json() const {
       {"mesh_level", parameters.mesh_level},
       {"bending_modulus", parameters.bending_modulus},
       {"viscosity_ratio", parameters.viscosity_ratio},
+      {"tilt", parameters.tilt},
+      {"azimuth", parameters.azimuth},
       {"regime", std::string(diagnostics::to_string(analysis.regime))},
       {"converged", converged},
       {"steps", steps},
@@ -208,6 +217,11 @@ CaseSummary CaseSummary::from_json(const nlohmann::json& j) {
     if (!vr->is_number()) throw std::invalid_argument("result: 'viscosity_ratio' is not a number");
     s.parameters.viscosity_ratio = vr->get<double>();
   }
+  for (auto [key, member] : {std::pair{"tilt", &CaseParameters::tilt}, std::pair{"azimuth", &CaseParameters::azimuth}})
+    if (const auto v = j.find(key); v != j.end()) {  // absent in results from before the orientation keys: 0
+      if (!v->is_number()) throw std::invalid_argument(std::string("result: '") + key + "' is not a number");
+      s.parameters.*member = v->get<double>();
+    }
   s.analysis.regime = regime_of(string_or_empty(j, "regime"));
   const auto converged = j.find("converged");
   s.converged = converged != j.end() && converged->is_boolean() && converged->get<bool>();
@@ -234,6 +248,8 @@ std::vector<io::Attribute> summary_attributes(const CaseSummary& s) {
   a.emplace_back("mesh_level", s.parameters.mesh_level);
   a.emplace_back("bending_modulus", s.parameters.bending_modulus);
   a.emplace_back("viscosity_ratio", s.parameters.viscosity_ratio);
+  a.emplace_back("tilt", s.parameters.tilt);
+  a.emplace_back("azimuth", s.parameters.azimuth);
   a.emplace_back("regime", std::string(diagnostics::to_string(s.analysis.regime)));
   a.emplace_back("converged", s.converged ? 1 : 0);
   a.emplace_back("steps", s.steps);

@@ -33,6 +33,8 @@ struct CaseParameters {
   int mesh_level = 0;
   double bending_modulus = 0;  ///< κ_b (JSON "bending_modulus"; a result from before the key reads as 0)
   double viscosity_ratio = 1;  ///< λ (JSON "viscosity_ratio"; a result from before the key reads as 1)
+  double tilt = 0;             ///< capsule.tilt, degrees (JSON "tilt"; a result from before the key reads as 0)
+  double azimuth = 0;          ///< capsule.azimuth, degrees (JSON "azimuth"; a result from before the key reads as 0)
 
   /// @brief The parameters of a resolved case configuration.
   static CaseParameters of(const config::CaseConfig& config);
@@ -58,6 +60,7 @@ struct CaseSummary {
   double membrane_s = 0, load_s = 0, stokes_s = 0;  ///< wall time of the phases (CaseResult)
   double gmres_iterations_mean = 0, gmres_iterations_max = 0;  ///< viscosity-ratio solve (CaseResult; 0 at λ = 1)
   double final_tilt = 0;  ///< degrees, CaseResult::final_tilt (NaN when read from a result from before it)
+  double tilt_growth_rate = 0, tilt_growth_rate_error = 0;  ///< per unit γ̇t, CaseResult (NaN: none, or before them)
   int threads = 0;
   std::string case_file;  ///< absolute path of case.h5
   std::string code_version;    ///< git commit of the build

@@ -45,6 +45,11 @@ get() { awk -F' = ' -v k="$1" '$1 == k { gsub(/"/, "", $2); print $2; exit }' "$
 ca=$(get capillary_number); ar=$(get aspect_ratio); law=$(get law); level=$(get level); C=$(get skalak_C)
 kb=$(get bending_modulus); kb=${kb:-0}
 lambda=$(get viscosity_ratio); lambda=${lambda:-1}
+# The initial orientation, echoed as the real worker does (FAKE_DROP_ORIENTATION=1: reported as the defaults, 0,
+# whatever the case says — a worker the store must refuse for a tilted case).
+tilt=$(get tilt); tilt=${tilt:-0}
+azimuth=$(get azimuth); azimuth=${azimuth:-0}
+[ "${FAKE_DROP_ORIENTATION:-0}" = 1 ] && tilt=0 azimuth=0
 C=${C:-1}
 in_list() { local v="$1" list="$2" x; IFS=',' read -ra xs <<< "$list"; for x in "${xs[@]}"; do [ "$x" = "$v" ] && return 0; done; return 1; }
 
@@ -86,7 +91,7 @@ reason=""
 [ $status = unstable ] && reason="NaN in velocity at t=3.2"
 # The result line goes through the real summary code (capsim _summary), as `capsim run --json` prints it.
 "$capsim_bin" _summary status="$status" reason="$reason" capillary_number="$ca" aspect_ratio="$ar" law="$law" \
-  skalak_C="$C" bending_modulus="$kb" viscosity_ratio="$lambda" mesh_level="$level" min_D12="$d" max_tau_min="$h" mean_D12="$mean" period=12.5 regime="$regime" \
+  skalak_C="$C" bending_modulus="$kb" viscosity_ratio="$lambda" tilt="$tilt" azimuth="$azimuth" mesh_level="$level" min_D12="$d" max_tau_min="$h" mean_D12="$mean" period=12.5 regime="$regime" \
   volume_drift=1e-4 steps=100 flow_evaluations=200 dt="$dt" t_final=25 wall_s=0.2 threads=1 case_file="$out/case.h5" \
   code_version=fake || exit 1
 [ -n "${FAKE_LOG:-}" ] && echo "done $out" >> "$FAKE_LOG"

@@ -201,9 +201,8 @@ struct PhysicalAxis {
   const char* out_of_range;
 };
 
-TEST(Grid, BendingModulusAndViscosityRatioAreAxes) {
-  for (const PhysicalAxis& a : {PhysicalAxis{"bending_modulus", "[0, 1e-3, 1e-2]", "bending_modulus = 0.01", "[-1]"},
-                                PhysicalAxis{"viscosity_ratio", "[1, 0.2, 5]", "viscosity_ratio = 5", "[25]"}}) {
+void expect_physical_axes(std::initializer_list<PhysicalAxis> axes) {
+  for (const PhysicalAxis& a : axes) {
     SCOPED_TRACE(a.axis);
     const auto spec = parse_campaign(std::string("[campaign]\nname='b'\n[defaults]\nflow.capillary_number=0.05\n"
                                                  "[[grid]]\n") + a.axis + "=" + a.values + "\n",
@@ -224,6 +223,17 @@ TEST(Grid, BendingModulusAndViscosityRatioAreAxes) {
       EXPECT_NE(std::string(e.what()).find(a.axis), std::string::npos) << e.what();
     }
   }
+}
+
+TEST(Grid, BendingModulusAndViscosityRatioAreAxes) {
+  expect_physical_axes({PhysicalAxis{"bending_modulus", "[0, 1e-3, 1e-2]", "bending_modulus = 0.01", "[-1]"},
+                        PhysicalAxis{"viscosity_ratio", "[1, 0.2, 5]", "viscosity_ratio = 5", "[25]"}});
+}
+
+// The initial orientation (alias tilt: capsule.tilt, azimuth: capsule.azimuth), the axes of a stability study.
+TEST(Grid, TiltAndAzimuthAreAxes) {
+  expect_physical_axes({PhysicalAxis{"tilt", "[0, 5, 90]", "tilt = 90", "[91]"},
+                        PhysicalAxis{"azimuth", "[0, 30, -45]", "azimuth = -45", "[-90]"}});
 }
 
 // [analysis] levels: the grid runs on the scan level; a mesh level given elsewhere contradicts it.

@@ -38,6 +38,10 @@ CaseSummary example() {
   s.solver_version = "2";
   s.kernel_isa = "avx2";
   s.final_tilt = 12.5;
+  s.tilt_growth_rate = -0.02;
+  s.tilt_growth_rate_error = 0.003;
+  s.parameters.tilt = 3.0;
+  s.parameters.azimuth = -30.0;
   return s;
 }
 
@@ -58,6 +62,29 @@ TEST(CaseSummary, JsonRoundTripKeepsEveryField) {
   EXPECT_EQ(t.wrinkle_max.wrinkle_amplitude, 2e-3);
   EXPECT_EQ(t.kernel_isa, "avx2");
   EXPECT_EQ(t.final_tilt, 12.5);
+  EXPECT_EQ(t.tilt_growth_rate, -0.02);
+  EXPECT_EQ(t.tilt_growth_rate_error, 0.003);
+  EXPECT_EQ(t.parameters.tilt, 3.0);
+  EXPECT_EQ(t.parameters.azimuth, -30.0);
+}
+
+// A result from before the orientation keys reads as the in-plane start (tilt 0, azimuth 0), with no growth rate; the
+// regimes off the plane read back by their names.
+TEST(CaseSummary, OrientationFieldsReadBackAndDefault) {
+  nlohmann::json j = example().to_json();
+  for (const char* key : {"tilt", "azimuth", "tilt_growth_rate", "tilt_growth_rate_error"}) j.erase(key);
+  const CaseSummary t = CaseSummary::from_json(j);
+  EXPECT_EQ(t.parameters.tilt, 0.0);
+  EXPECT_EQ(t.parameters.azimuth, 0.0);
+  EXPECT_TRUE(std::isnan(t.tilt_growth_rate));
+  j["tilt"] = "five";
+  EXPECT_THROW(CaseSummary::from_json(j), std::invalid_argument);
+  for (const auto regime : {diagnostics::Regime::rolling, diagnostics::Regime::wobbling, diagnostics::Regime::kayaking,
+                            diagnostics::Regime::oscillating_swinging}) {
+    CaseSummary s = example();
+    s.analysis.regime = regime;
+    EXPECT_EQ(CaseSummary::from_json(s.to_json()).analysis.regime, regime) << diagnostics::to_string(regime);
+  }
 }
 
 // A result line from before kernel_isa existed still reads (the committed databases hold thousands).
@@ -85,7 +112,8 @@ TEST(CaseSummary, JsonHasTheContractKeys) {
                           "max_load_roughness", "wrinkle_wavelength", "wrinkle_amplitude", "max_wrinkle_amplitude",
                           "wrinkle_wavelength_of_max", "steps", "flow_evaluations", "dt", "t_final",
                           "wall_s", "threads",
-                          "case_file", "code_version", "kernel_isa", "solver_version"})
+                          "case_file", "code_version", "kernel_isa", "solver_version", "tilt", "azimuth",
+                          "final_tilt", "tilt_growth_rate", "tilt_growth_rate_error"})
     EXPECT_TRUE(j.contains(key)) << key;
 }
 
@@ -113,6 +141,13 @@ TEST(CaseSummary, ParameterMismatchComparesEveryParameter) {
   EXPECT_EQ(parameter_mismatch(nh2, nh), "") << "skalak_C does not enter a neo-Hookean case";
   nh2.law = config::MembraneLawKind::Skalak;
   EXPECT_NE(parameter_mismatch(nh2, nh), "");
+  // The initial orientation is a parameter of the case like the others.
+  q = p;
+  q.tilt = 5.0;
+  EXPECT_EQ(parameter_mismatch(p, q), "tilt 0.0");
+  q = p;
+  q.azimuth = 30.0;
+  EXPECT_EQ(parameter_mismatch(q, p), "azimuth 30.0");
 }
 
 // What run_case stores as case.h5's attributes is the summary (with the case file's own code_version).

@@ -206,8 +206,8 @@ TEST_F(ScriptsTest, PlotsTheViscosityRatioFigureFromTheCommittedStudy) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(is_png(out / "viscosity_ratio_figure7.png"));
   const std::string table = slurp(out / "viscosity_ratio_table.md");
-  EXPECT_EQ(count_lines(table), 2 + 2 * 3 * 3) << table;  // header, rule, 2 laws × 3 a/b × 3 λ
-  for (const char* lam : {"| 0.2 |", "| 1 |", "| 5 |"}) EXPECT_NE(table.find(lam), std::string::npos) << lam;
+  EXPECT_EQ(count_lines(table), 2 + 2 * 3 * 4) << table;  // header, rule, 2 laws × 3 a/b × 4 λ
+  for (const char* lam : {"| 0.2 |", "| 1 |", "| 5 |", "| 10 |"}) EXPECT_NE(table.find(lam), std::string::npos) << lam;
   const Cmd one = sh(plot() + " --db " + q(dir_ / "fixture.sqlite") + " --only 7 --out " + q(out / "one"));
   EXPECT_EQ(one.code, 2) << one.err;
   EXPECT_NE(one.err.find("one viscosity ratio only"), std::string::npos) << one.err;

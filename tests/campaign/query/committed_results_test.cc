@@ -154,7 +154,7 @@ TEST(CommittedResults, OblateTransitionAtSmallBendingIsWhatTheDatabaseGives) {
 
 // The viscosity-ratio study (results/viscosity_ratio/README.md): each λ's Table 1 as committed.
 TEST(CommittedResults, ViscosityRatioStudyTablesAreWhatThisBuildComputesFromItsDatabase) {
-  for (const char* lambda : {"0.2", "1", "5"})
+  for (const char* lambda : {"0.2", "1", "5", "10"})
     expect_query_reproduces("viscosity_ratio/viscosity_ratio.sqlite",
                             std::string("viscosity_ratio/table1_lambda") + lambda + ".json", "", 6, true,
                             std::string("--viscosity-ratio ") + lambda);

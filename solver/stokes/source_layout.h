@@ -65,6 +65,12 @@ struct NormalSourceArrays {
 void layout_normal_points(const std::vector<mesh::P2Point>& rule, const std::vector<std::array<int, 6>>& elements,
                           const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v, NormalSourceArrays& out);
 
+/// @brief The density part of layout_normal_points alone: out.vx, vy, vz at the points of `rule` on every element
+/// (the P2 interpolant Σ_a N_a v_a), element-major; positions and normals are left as they are (the double layer
+/// lays them out once per surface and the density once per application).
+void layout_density(const std::vector<mesh::P2Point>& rule, const std::vector<std::array<int, 6>>& elements,
+                    const Eigen::Matrix3Xd& v, NormalSourceArrays& out);
+
 /// @brief acc += sign · Σ_{p ∈ [begin, end)} (v_p − v0)·T(x_p − x0)·n_p (kernel::add_stresslet) for one target
 /// x0 with density v0 (vectorised over p; a source at the target contributes nothing).
 inline void add_double_layer_block(const double x0[3], const double v0[3], const NormalSourceArrays& s, int begin,

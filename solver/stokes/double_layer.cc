@@ -81,17 +81,17 @@ void DoubleLayer::regular_sum(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd&
 namespace {
 
 // W[a][m] += sign · Σ_p N_a(p) G_m(p) over `count` points, G(p) = −6 (r·n)/|r|⁵ · r rᵀ (its six entries xx, xy, xz,
-// yy, yz, zz), r = (rx, ry, rz)[p] from the target to the point, n = (nx, ny, nz)[p] the weighted normal, N the
+// yy, yz, zz), r = (px, py, pz)[p] − x0 from the target to the point, n = (nx, ny, nz)[p] the weighted normal, N the
 // shape table (a-major, stride `count`): the stresslet kernel::add_stresslet as a matrix on the density
 // difference, d·T·n = G d. A point at the target contributes nothing. g: work array.
-void accumulate_points(const double* rx, const double* ry, const double* rz, const double* nx, const double* ny,
-                       const double* nz, int count, const double* shape, double sign, std::vector<double>& g,
-                       double W[6][6]) {
+void accumulate_points(const double* px, const double* py, const double* pz, const double* nx, const double* ny,
+                       const double* nz, const double x0[3], int count, const double* shape, double sign,
+                       std::vector<double>& g, double W[6][6]) {
   g.resize(static_cast<std::size_t>(6) * count);
   double *g0 = g.data(), *g1 = g0 + count, *g2 = g1 + count, *g3 = g2 + count, *g4 = g3 + count, *g5 = g4 + count;
 #pragma omp simd
   for (int p = 0; p < count; ++p) {
-    const double x = rx[p], y = ry[p], z = rz[p];
+    const double x = px[p] - x0[0], y = py[p] - x0[1], z = pz[p] - x0[2];
     const double r2 = x * x + y * y + z * z;
     const double inv = r2 == 0.0 ? 0.0 : kernel::rsqrt_arith(r2);
     // kernel::add_stresslet with the density left out: its u = s r, s = −6 (d·r)(r·n)/r⁵ = (d·r) c.
@@ -172,22 +172,19 @@ void DoubleLayer::prepare_corrections(const Eigen::Matrix3Xd& x) {
           if (slots[a] >= 0)
             for (int m = 0; m < 6; ++m) row[6 * slots[a] + m] += W[a][m];
       };
-      // Points of a laid-out block relative to x0 (rx, ry, rz) and their normals.
-      auto relative = [&](const NormalSourceArrays& s, int begin, int count) {
-        for (auto* a : {&rx, &ry, &rz, &nx, &ny, &nz}) a->resize(static_cast<std::size_t>(count));
-        for (int p = 0; p < count; ++p) {
-          rx[p] = s.x[begin + p] - x0[0], ry[p] = s.y[begin + p] - x0[1], rz[p] = s.z[begin + p] - x0[2];
-          nx[p] = s.nx[begin + p], ny[p] = s.ny[begin + p], nz[p] = s.nz[begin + p];
-        }
+      // A laid-out block of points against x0.
+      auto block = [&](const NormalSourceArrays& s, int begin, int count, const double* shape, double sign,
+                       double W[6][6]) {
+        accumulate_points(s.x.data() + begin, s.y.data() + begin, s.z.data() + begin, s.nx.data() + begin,
+                          s.ny.data() + begin, s.nz.data() + begin, x0, count, shape, sign, g, W);
       };
+      constexpr double kApex[3] = {0.0, 0.0, 0.0};  // the Duffy points are relative to x0 already
       for (int k = topo_.node_offsets[i]; k < topo_.node_offsets[i + 1]; ++k) {
         const int e = topo_.inc_element[k], l = topo_.inc_local[k];
         const auto& el = topo_.elements[e];
         double W[6][6] = {};
         // Remove what the regular rule counts for this element ...
-        relative(sources_, e * nq, nq);
-        accumulate_points(rx.data(), ry.data(), rz.data(), nx.data(), ny.data(), nz.data(), nq,
-                          regular_shape_.data(), -1.0, g, W);
+        block(sources_, e * nq, nq, regular_shape_.data(), -1.0, W);
         // ... and add the Duffy integral with the node at the apex, the geometry on x − x0 in monomial form (it
         // vanishes at the apex exactly, so the kernel keeps its accuracy next to it).
         double R[6][3], C[6][3];
@@ -216,7 +213,7 @@ void DoubleLayer::prepare_corrections(const Eigen::Matrix3Xd& x) {
           qy[p] = w * (g1[2] * g2[0] - g1[0] * g2[2]);
           qz[p] = w * (g1[0] * g2[1] - g1[1] * g2[0]);
         }
-        accumulate_points(px, py, pz, qx, qy, qz, tb.count, duffy_shape_[l].data(), 1.0, g, W);
+        accumulate_points(px, py, pz, qx, qy, qz, kApex, tb.count, duffy_shape_[l].data(), 1.0, g, W);
         add(own_slots_.data() + 6 * k, W);
       }
       // Near-singular neighbours: the subdivided rule in, the regular rule out (negative weights in near_rule_).
@@ -224,9 +221,7 @@ void DoubleLayer::prepare_corrections(const Eigen::Matrix3Xd& x) {
         for (int k = near_.offsets[i]; k < near_.offsets[i + 1]; ++k) {
           const int e = near_.elements[k];
           double W[6][6] = {};
-          relative(near_points_, e * nr, nr);
-          accumulate_points(rx.data(), ry.data(), rz.data(), nx.data(), ny.data(), nz.data(), nr,
-                            near_shape_.data(), 1.0, g, W);
+          block(near_points_, e * nr, nr, near_shape_.data(), 1.0, W);
           add(near_slots_.data() + 6 * k, W);
         }
     }

@@ -106,6 +106,16 @@ int bench_flow(const BenchArgs& ba) {
                         {"volume_ms", s.volume_ms},
                         {"second_kind_ms", s.second_kind_ms},
                         {"gmres_iterations", s.gmres_iterations},
+                        {"layer_applications", s.layer_applications},
+                        {"layer_prepare_ms", s.layer_prepare_ms},
+                        {"layer_layout_ms", s.layer_layout_ms},
+                        {"layer_regular_ms", s.layer_regular_ms},
+                        {"layer_singular_ms", s.layer_singular_ms},
+                        {"layer_near_ms", s.layer_near_ms},
+                        {"deflation_setup_ms", s.deflation_setup_ms},
+                        {"gmres_other_ms", s.gmres_other_ms},
+                        {"evaluation_warm_ms", s.evaluation_warm_ms},
+                        {"gmres_iterations_warm", s.gmres_iterations_warm},
                         {"evaluation_equal_viscosity_ms", s.evaluation_equal_viscosity_ms},
                         {"other_ms", s.other_ms}});
     // The symmetric scene's fields also at the top level: the scene of every run that starts in the shear plane.
@@ -139,6 +149,25 @@ int bench_flow(const BenchArgs& ba) {
   std::printf("ratio = evaluation / bare regular sum (double) over the same targets and sources (medians of %d, "
               "alternated); phases are means per evaluation in ms\n",
               r.scenes.front().repeat);
+  if (scene.viscosity_ratio != 1.0) {
+    std::printf("viscosity ratio %g: the second-kind solve by phase, ms per evaluation (every timed solve cold)\n",
+                scene.viscosity_ratio);
+    std::printf("%-10s %9s %9s %7s %7s %6s | %8s %8s %8s %8s %8s %8s %8s %8s\n", "scene", "eval ms", "lambda=1",
+                "ratio", "iters", "apps", "solve", "D prep", "D layout", "D regul", "D corr", "D rest", "setup",
+                "gmres");
+    for (const auto& s : r.scenes)
+      std::printf("%-10s %9.3f %9.3f %7.2f %7.2f %6.2f | %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f\n",
+                  s.name.c_str(), s.evaluation_ms, s.evaluation_equal_viscosity_ms,
+                  s.evaluation_equal_viscosity_ms > 0.0 ? s.evaluation_ms / s.evaluation_equal_viscosity_ms : 0.0,
+                  s.gmres_iterations, s.layer_applications, s.second_kind_ms, s.layer_prepare_ms, s.layer_layout_ms,
+                  s.layer_regular_ms,
+                  s.layer_singular_ms, s.layer_near_ms, s.deflation_setup_ms, s.gmres_other_ms);
+    for (const auto& s : r.scenes)
+      std::printf("%s: second stage (x + dt v, warm-started from the first): %.3f ms, %.2f iterations, %.2fx lambda = 1\n",
+                  s.name.c_str(), s.evaluation_warm_ms, s.gmres_iterations_warm,
+                  s.evaluation_equal_viscosity_ms > 0.0 ? s.evaluation_warm_ms / s.evaluation_equal_viscosity_ms : 0.0);
+    std::printf("ratio = evaluation / the same scene at lambda = 1 (medians, alternated in this run)\n");
+  }
   if (scene.kernel_precision != "double")
     for (const auto& s : r.scenes)
       std::printf("%s: %s evaluation %.3f ms, double %.3f ms (alternated in this run): %.2fx faster\n", s.name.c_str(),

@@ -65,6 +65,15 @@ struct SecondKindStatistics {
   long solves = 0;         ///< converged solves (one per boundary_velocity)
   long iterations = 0;     ///< Krylov iterations summed over them
   int max_iterations = 0;  ///< the largest count of one solve
+  long applications = 0;   ///< applications of the double layer (the iterations and each warm start's residual)
+  // Wall time of the solves by phase (seconds, summed; stokes::SecondKindResult): not checkpointed.
+  double setup_s = 0.0;           ///< deflation set-up
+  double layer_prepare_s = 0.0;   ///< double layer: the surface's point geometry and correction matrices
+  double layer_layout_s = 0.0;    ///< double layer: symmetry checks, the density at the points
+  double layer_regular_s = 0.0;   ///< double layer: regular all-pairs sum
+  double layer_singular_s = 0.0;  ///< double layer: the singular and near-singular corrections
+  double layer_near_s = 0.0;      ///< double layer: −4πv, symmetry images
+  double total_s = 0.0;           ///< the solves in all
   /// @brief Mean iterations per solve (0 without solves).
   [[nodiscard]] double mean_iterations() const {
     return solves > 0 ? static_cast<double>(iterations) / static_cast<double>(solves) : 0.0;

@@ -33,7 +33,8 @@ double CostModel::evaluation_ms(const config::CaseConfig& config) {
   const double single = evaluation_ms(config.level, symmetry(config), config.kernel_precision == "mixed");
   const double applications = double_layer_applications(config);
   if (applications == 0.0) return single;  // λ = 1: the single layer alone
-  return single + applications * double_layer_ms(config.level, symmetry(config));
+  return single +
+         applications * double_layer_ms(config.level, symmetry(config), config.kernel_precision == "mixed");
 }
 
 double CostModel::double_layer_applications(const config::CaseConfig& config) {
@@ -41,10 +42,10 @@ double CostModel::double_layer_applications(const config::CaseConfig& config) {
   return kGmresIterationsPerDecade * -std::log10(config.viscosity_tolerance);
 }
 
-double CostModel::double_layer_ms(int level, SceneSymmetry symmetry) {
+double CostModel::double_layer_ms(int level, SceneSymmetry symmetry, bool mixed_precision) {
   const double targets = target_reduction(symmetry);
-  return kDoubleLayerPerSingleLayer *
-         (kRegularSumMs * std::pow(16.0, level - 3) + kCorrectionsMs * std::pow(4.0, level - 3)) / targets;
+  const double sum = kRegularSumMs * std::pow(16.0, level - 3) / (mixed_precision ? kMixedSumSpeedup : 1.0);
+  return kDoubleLayerPerSingleLayer * (sum + kCorrectionsMs * std::pow(4.0, level - 3)) / targets;
 }
 
 double CostModel::case_cost(const config::CaseConfig& config, double h_min) {

@@ -68,7 +68,23 @@ struct FlowBenchScene {
   /// Mean GMRES iterations per evaluation of the viscosity-ratio solve (0 at λ = 1). Every timed evaluation starts
   /// a step (CapsuleFlow::begin_step): a cold solve, the first stage of a step, the dearest.
   double gmres_iterations = 0.0;
+  /// The viscosity-ratio solve (second_kind_ms) by phase, means per evaluation (all 0 at λ = 1): the double
+  /// layer's applications per evaluation and their phases (DoubleLayerStats), the deflation set-up, and the rest
+  /// (GMRES's own vector work).
+  double layer_applications = 0.0;
+  double layer_prepare_ms = 0.0;
+  double layer_layout_ms = 0.0;
+  double layer_regular_ms = 0.0;
+  double layer_singular_ms = 0.0;
+  double layer_near_ms = 0.0;
+  double deflation_setup_ms = 0.0;
+  double gmres_other_ms = 0.0;
   double evaluation_equal_viscosity_ms = 0.0;  ///< the same scene at λ = 1, alternated (0 when λ = 1 already)
+  /// At λ ≠ 1, the evaluation of a second stage: at x + dt v (dt the case's automatic step, v the first stage's
+  /// velocity), warm-started from the first stage's solution, as the later stages of a step are (median wall
+  /// time, after the timed loop), and its mean GMRES iterations. Both 0 at λ = 1.
+  double evaluation_warm_ms = 0.0;
+  double gmres_iterations_warm = 0.0;
   double other_ms = 0.0;        ///< mean evaluation time not in a named phase (timers, copies)
 };
 

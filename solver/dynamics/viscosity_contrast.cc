@@ -21,6 +21,14 @@ void ViscosityContrast::solve(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd&
   else
     v.resize(3, 0);
   last_ = stokes::solve_second_kind(layer_, mesh_, x, lambda_, f, v, options_);
+  stats_.applications += last_.applications;
+  stats_.setup_s += last_.setup_s;
+  stats_.layer_prepare_s += last_.layer_prepare_s;
+  stats_.layer_layout_s += last_.layer_layout_s;
+  stats_.layer_regular_s += last_.layer_regular_s;
+  stats_.layer_singular_s += last_.layer_singular_s;
+  stats_.layer_near_s += last_.layer_near_s;
+  stats_.total_s += last_.total_s;
   if (!last_.converged) {
     warm_ = false;
     std::ostringstream msg;

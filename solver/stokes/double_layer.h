@@ -32,11 +32,21 @@
 /// filled by the symmetry (expand_mirror, expand_central).
 ///
 /// Options: the quadrature fields of SingleLayerOptions (regular_degree, duffy_order, near_subdivision,
-/// near_degree) and the symmetry fields (symmetry, central_symmetry, symmetry_tol, load_symmetry_tol), so that
-/// the two layers of one case integrate on the same rules with the same symmetries. The far-field tier, the kernel
-/// choice and the mixed precision of the single layer are not implemented here and are ignored: every phase
-/// runs in double, in `omp simd` loops (the regular sum with targets in lanes, 16 per tile; the near-singular
-/// blocks with add_double_layer_blocks; the Duffy points with add_stresslet).
+/// near_degree), the symmetry fields (symmetry, central_symmetry, symmetry_tol, load_symmetry_tol), so that the
+/// two layers of one case integrate on the same rules with the same symmetries, and the kernel choice and
+/// precision of the regular sum (kernel: Fast, the SIMD tile kernel::stresslet_sum_fast, or Plain,
+/// stresslet_sum_plain; precision Mixed with Fast: stresslet_sum_mixed, float pair terms summed in double, as the
+/// single layer's sum_mixed; stokeslet.h). The far-field tier is not implemented here and is ignored.
+///
+/// What depends on the surface alone is prepared once per x and target set and kept while they do not change
+/// (every application within one second-kind solve): the positions and weighted normals of the regular points,
+/// and the two corrections as matrices on the density differences. Both corrections are linear in v − v(x0), so
+/// for target x0 they are Σ_b G_b (v_b − v(x0)) over the nodes b of its own and near-singular elements, G_b a
+/// symmetric 3 × 3 matrix (Σ over the element's points of N_b · (−6 (r·n)/|r|⁵) r rᵀ, the stresslet of
+/// kernel::add_stresslet with the density factored out): an application then lays out the density at the regular
+/// points, runs the all-pairs sum and applies these matrices (a few dozen per target), in place of re-integrating
+/// the Duffy and subdivided rules. The Duffy geometry stays in monomial form about the target (as before), in
+/// double; the corrections are in double in both precisions.
 ///
 /// Contract: as SingleLayer (connectivity cached from the constructor and unchanging; positions and density may
 /// change freely between calls; one object must not be used by two threads at once; internally OpenMP-parallel
@@ -63,10 +73,13 @@ struct DoubleLayerStats {
   bool used_central = false;   ///< whether the central symmetry was used
   int targets = 0;          ///< number of targets evaluated
   int sources = 0;          ///< quadrature points of the regular all-pairs sum
-  double build_s = 0.0;     ///< laying out the regular and near-rule points (SoA)
+  bool prepared = false;    ///< whether this call (re)built the surface's data (a new x or target set)
+  double prepare_s = 0.0;   ///< that: the points' geometry and the correction matrices (0 when kept)
+  double build_s = 0.0;     ///< symmetry checks, the density at the regular points (SoA)
   double regular_s = 0.0;   ///< regular all-pairs sum
-  double singular_s = 0.0;  ///< own elements: regular rule out, Duffy rule in
-  double near_s = 0.0;      ///< near-singular elements: regular rule out, subdivided rule in
+  double singular_s = 0.0;  ///< the corrections (own elements: Duffy in, regular out; near ones: subdivided in,
+                            ///< regular out), applied as the prepared matrices
+  double near_s = 0.0;      ///< − 4π v(x0) and the symmetry images
   double total_s = 0.0;
 };
 
@@ -79,6 +92,9 @@ class DoubleLayer {
   /// @brief D[v] at every node; x and v are 3 × num_nodes. u is resized as needed.
   /// @throws std::invalid_argument if x or v has the wrong number of columns.
   void apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v, Eigen::Matrix3Xd& u);
+  /// @brief Drops what was prepared for the last surface (the next apply prepares again, even on the same x). The
+  /// second-kind solve calls it once per solve, so that a solve costs the same whether or not x repeats.
+  void forget_surface() { prepared_ = false; }
   /// @brief Convenience overload returning D[v].
   [[nodiscard]] Eigen::Matrix3Xd apply(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v);
 
@@ -100,22 +116,38 @@ class DoubleLayer {
   [[nodiscard]] int num_elements() const { return static_cast<int>(topo_.elements.size()); }
 
  private:
-  void regular_sum(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v, Eigen::Matrix3Xd& u) const;
-  void singular_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v, Eigen::Matrix3Xd& u) const;
-  void near_correction(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v, Eigen::Matrix3Xd& u) const;
+  [[nodiscard]] bool uses_mixed_precision() const;
+  void regular_sum(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v, Eigen::Matrix3Xd& u);
+  void make_correction_slots();
+  void prepare_corrections(const Eigen::Matrix3Xd& x);
+  void apply_corrections(const Eigen::Matrix3Xd& v, Eigen::Matrix3Xd& u) const;
 
   SingleLayerOptions opt_;
   BoundaryMesh topo_;
   mesh::P2Tabulation rule_;               // the regular rule (flux_weights)
   std::vector<mesh::P2Point> regular_;    // its points (layout)
+  std::vector<double> regular_shape_;     // its shape functions (a-major SoA)
   PointTable duffy_[6];                   // Duffy rule per local node position (SoA)
+  std::vector<double> duffy_shape_[6];    // their shape functions
   std::vector<mesh::P2Point> near_rule_;  // subdivided rule, then the regular rule negated (empty if off)
+  std::vector<double> near_shape_;        // its shape functions
   NearSingularElements near_;             // node → near-singular elements (empty if off)
-  std::vector<int> near_begin_;           // first near point of each entry of near_.elements
-  // Work arrays of apply().
+  // Prepared for one surface x and target set (apply: kept while both stay the same).
+  bool prepared_ = false, prepared_mirror_ = false, prepared_central_ = false;
+  Eigen::Matrix3Xd prepared_x_;
   std::vector<int> targets_;              // the nodes evaluated (all, or one of each orbit)
-  NormalSourceArrays sources_;            // regular points of every element
-  NormalSourceArrays near_points_;        // near-rule points of every element
+  NormalSourceArrays sources_;            // regular points of every element (geometry prepared, density per apply)
+  NormalSourceArrays near_points_;        // near-rule points of every element (geometry)
+  // The corrections as matrices on the density differences: target i gets Σ_k G_k (v_{node_k} − v_i) over k in
+  // [offsets[i], offsets[i+1]) (the nodes of its own and near-singular elements, fixed by the topology), G_k
+  // symmetric 3 × 3 (xx, xy, xz, yy, yz, zz; prepared for the targets). own_slots_ / near_slots_: for each
+  // incidence (node_offsets order) and near entry (near_.elements order), the slot of each of the element's six
+  // nodes in that list (−1: the target itself).
+  std::vector<int> correction_offsets_, correction_nodes_, own_slots_, near_slots_;
+  std::vector<int> row_offsets_;           // the targets' rows of correction_weights_ (targets_ order)
+  std::vector<double> correction_weights_;
+  // Work arrays of the regular sum (targets and results as SoA).
+  AlignedVector tx_, ty_, tz_, tvx_, tvy_, tvz_, ux_, uy_, uz_;
   DoubleLayerStats stats_;
 };
 

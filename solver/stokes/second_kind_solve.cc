@@ -1,5 +1,6 @@
 #include "solver/stokes/second_kind_solve.h"
 
+#include <chrono>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -13,6 +14,10 @@ namespace {
 
 using Vec = Eigen::VectorXd;
 
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
 bool fail(std::string* why, const std::string& message) {
   if (why != nullptr) *why = message;
   return false;
@@ -25,6 +30,7 @@ class SystemOperator {
   SystemOperator(DoubleLayer& layer, const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x, double kappa,
                  bool deflate)
       : layer_(layer), x_(x), kappa_(kappa), deflate_(deflate) {
+    layer_.forget_surface();  // prepared by the first application (its cost is the solve's)
     if (!deflate_) return;
     const Eigen::Index n = x.cols();
     // The six rigid motions at the nodes (translations e_k, rotations e_k × x), orthonormalised.
@@ -49,10 +55,19 @@ class SystemOperator {
     const Eigen::Index n = x_.cols();
     density_ = Eigen::Map<const Eigen::Matrix3Xd>(w.data(), 3, n);
     layer_.apply(x_, density_, result_);
+    const DoubleLayerStats& st = layer_.last_stats();
+    prepare_s += st.prepare_s;
+    layout_s += st.build_s;
+    regular_s += st.regular_s;
+    singular_s += st.singular_s;
+    near_s += st.near_s;
     Vec kw = Eigen::Map<const Vec>(result_.data(), 3 * n) / (4.0 * std::numbers::pi);
     if (deflate_) kw += q_ * (q_.transpose() * w) - u_ * a_.dot(w);
     return w - kappa_ * kw;
   }
+
+  // Time in the applications of D, by DoubleLayerStats phase (seconds, summed).
+  double prepare_s = 0.0, layout_s = 0.0, regular_s = 0.0, singular_s = 0.0, near_s = 0.0;
 
   // Q Qᵀ w (the rigid-motion part of w).
   [[nodiscard]] Vec rigid_part(const Vec& w) const { return q_ * (q_.transpose() * w); }
@@ -202,7 +217,9 @@ SecondKindResult solve_second_kind(DoubleLayer& layer, const mesh::SurfaceMesh& 
     out.reason = "viscosity ratio 1";
     return out;
   }
+  const double t0 = now_s();
   SystemOperator op(layer, mesh, x, kappa, options.deflate);
+  out.setup_s = now_s() - t0;
   const Vec g = Eigen::Map<const Vec>(f.data(), 3 * n) * (2.0 / (1.0 + lambda));
   const bool warm = v.cols() == n;
   Vec w = Vec::Zero(3 * n);
@@ -213,6 +230,12 @@ SecondKindResult solve_second_kind(DoubleLayer& layer, const mesh::SurfaceMesh& 
   gmres(op, g, w, warm, options, out);
   if (options.deflate) w -= kappa / (1.0 + kappa) * op.rigid_part(w);
   v = Eigen::Map<const Eigen::Matrix3Xd>(w.data(), 3, n);
+  out.layer_prepare_s = op.prepare_s;
+  out.layer_layout_s = op.layout_s;
+  out.layer_regular_s = op.regular_s;
+  out.layer_singular_s = op.singular_s;
+  out.layer_near_s = op.near_s;
+  out.total_s = now_s() - t0;
   return out;
 }
 

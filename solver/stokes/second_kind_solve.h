@@ -64,6 +64,16 @@ struct SecondKindResult {
   /// "converged", "initial guess already converged", "viscosity ratio 1", "iteration limit", "breakdown" or
   /// "non-finite residual".
   std::string reason;
+  // Wall time of the solve by phase (seconds): the deflation set-up (rigid-motion basis, flux weights, node
+  // normals), the applications of D summed by DoubleLayerStats phase, and the whole solve; what is left of
+  // total_s is GMRES's own work (orthogonalisation, deflation terms, vector updates).
+  double setup_s = 0.0;          ///< SystemOperator set-up (0 without deflation)
+  double layer_prepare_s = 0.0;  ///< DoubleLayerStats::prepare_s, summed over the applications
+  double layer_layout_s = 0.0;   ///< DoubleLayerStats::build_s, summed
+  double layer_regular_s = 0.0;  ///< DoubleLayerStats::regular_s, summed
+  double layer_singular_s = 0.0; ///< DoubleLayerStats::singular_s, summed
+  double layer_near_s = 0.0;     ///< DoubleLayerStats::near_s, summed
+  double total_s = 0.0;          ///< the whole solve_second_kind call
 };
 
 /// @brief Solves (1 + λ)/2 · v − (1 − λ)/(8π) · D[v] = f on the surface x (see the file comment).

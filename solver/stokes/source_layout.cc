@@ -107,6 +107,27 @@ void layout_normal_points(const std::vector<mesh::P2Point>& rule, const std::vec
   }
 }
 
+void layout_density(const std::vector<mesh::P2Point>& rule, const std::vector<std::array<int, 6>>& elements,
+                    const Eigen::Matrix3Xd& v, NormalSourceArrays& out) {
+  const int ne = static_cast<int>(elements.size()), nq = static_cast<int>(rule.size());
+  for (auto* a : {&out.vx, &out.vy, &out.vz}) a->resize(static_cast<std::size_t>(ne) * static_cast<std::size_t>(nq));
+  double* den[3] = {out.vx.data(), out.vy.data(), out.vz.data()};
+#pragma omp parallel for schedule(static)
+  for (int e = 0; e < ne; ++e) {
+    double V[6][3];
+    for (int a = 0; a < 6; ++a)
+      for (int c = 0; c < 3; ++c) V[a][c] = v(c, elements[e][a]);
+    for (int k = 0; k < nq; ++k) {
+      const std::size_t j = static_cast<std::size_t>(e) * nq + k;
+      for (int c = 0; c < 3; ++c) {
+        double s = 0.0;
+        for (int a = 0; a < 6; ++a) s += rule[k].n[a] * V[a][c];
+        den[c][j] = s;
+      }
+    }
+  }
+}
+
 std::vector<mesh::P2Point> replace_rule(const std::vector<mesh::P2Point>& a, const std::vector<mesh::P2Point>& b) {
   std::vector<mesh::P2Point> out = a;
   for (const mesh::P2Point& p : b) {

@@ -30,6 +30,16 @@ inline void blocks(const double x0[3], const Sources& s, const int* begins, int 
   lanes::blocks<Lanes>(x0, {s.x, s.y, s.z, s.qx, s.qy, s.qz}, begins, count, length, u);
 }
 
+// The double layer's tile: two target vectors (register blocking), 1/r hybrid (InvSqrt::Hybrid).
+constexpr int kStressletBlock = 2;
+constexpr int kStressletWidth = kLanes * kStressletBlock;
+inline void stresslet_tile(const double* const (&t)[6], const StressletSources& s, double* ux, double* uy,
+                           double* uz) {
+  lanes::stresslet_tile<Lanes, kStressletBlock, 2>(t, {s.x, s.y, s.z, s.vx, s.vy, s.vz, s.nx, s.ny, s.nz}, s.n,
+                                                   ux, uy, uz);
+}
+constexpr bool kStressletTiles = true;
+
 #else
 constexpr int kLanes = 8;
 constexpr const char* kIsa = "portable";
@@ -67,6 +77,10 @@ inline void blocks(const double x0[3], const Sources& s, const int* begins, int 
     u[2] += az[l];
   }
 }
+
+constexpr int kStressletWidth = 16;
+inline void stresslet_tile(const double* const (&)[6], const StressletSources&, double*, double*, double*) {}
+constexpr bool kStressletTiles = false;  // stresslet_sum_fast is the plain loop
 #endif
 
 template <int B, int kMode>
@@ -136,6 +150,53 @@ void sum_plain(const Targets& t, const Sources& s, const Result& u) {
     u.x[i] = ax;
     u.y[i] = ay;
     u.z[i] = az;
+  }
+}
+
+void stresslet_sum_plain(const StressletTargets& t, const StressletSources& s, const Result& u) {
+  const int nt = t.n, ns = s.n;
+  const double *sx = s.x, *sy = s.y, *sz = s.z, *vx = s.vx, *vy = s.vy, *vz = s.vz, *nx = s.nx, *ny = s.ny,
+               *nz = s.nz;
+#pragma omp parallel for schedule(static)
+  for (int i = 0; i < nt; ++i) {
+    const double x0 = t.x[i], y0 = t.y[i], z0 = t.z[i], v0x = t.vx[i], v0y = t.vy[i], v0z = t.vz[i];
+    double ax = 0.0, ay = 0.0, az = 0.0;
+#pragma omp simd reduction(+ : ax, ay, az)
+    for (int j = 0; j < ns; ++j) {
+      const double rx = sx[j] - x0, ry = sy[j] - y0, rz = sz[j] - z0;
+      const double r2 = rx * rx + ry * ry + rz * rz;
+      const double inv = r2 == 0.0 ? 0.0 : 1.0 / std::sqrt(r2);
+      add_stresslet(rx, ry, rz, vx[j] - v0x, vy[j] - v0y, vz[j] - v0z, nx[j], ny[j], nz[j], inv, ax, ay, az);
+    }
+    u.x[i] = ax;
+    u.y[i] = ay;
+    u.z[i] = az;
+  }
+}
+
+void stresslet_sum_fast(const StressletTargets& t, const StressletSources& s, const Result& u) {
+  if (!kStressletTiles) {
+    stresslet_sum_plain(t, s, u);
+    return;
+  }
+  constexpr int W = kStressletWidth;
+  const int ntiles = (t.n + W - 1) / W;
+#pragma omp parallel for schedule(static)
+  for (int it = 0; it < ntiles; ++it) {
+    const int i0 = it * W;
+    // Every tile through a local copy (six short arrays; the last tile padded with copies of the last target,
+    // whose results are dropped).
+    alignas(64) double b[6][W], ox[W], oy[W], oz[W];
+    const double* in[6] = {t.x, t.y, t.z, t.vx, t.vy, t.vz};
+    for (int k = 0; k < 6; ++k)
+      for (int l = 0; l < W; ++l) b[k][l] = in[k][std::min(i0 + l, t.n - 1)];
+    const double* const tp[6] = {b[0], b[1], b[2], b[3], b[4], b[5]};
+    stresslet_tile(tp, s, ox, oy, oz);
+    for (int l = 0; l < W && i0 + l < t.n; ++l) {
+      u.x[i0 + l] = ox[l];
+      u.y[i0 + l] = oy[l];
+      u.z[i0 + l] = oz[l];
+    }
   }
 }
 

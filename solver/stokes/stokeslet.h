@@ -134,6 +134,59 @@ void sum_mixed(const Targets& t, const Sources& s, const Result& u);
 /// contract. On other builds it is sum_mixed.
 void sum_mixed_8_lanes(const Targets& t, const Sources& s, const Result& u);
 
+/// @brief Double-layer targets: positions and the density there, structure of arrays (n entries each).
+struct StressletTargets {
+  const double* x = nullptr;
+  const double* y = nullptr;
+  const double* z = nullptr;
+  const double* vx = nullptr;
+  const double* vy = nullptr;
+  const double* vz = nullptr;
+  int n = 0;
+};
+
+/// @brief Double-layer sources: positions, density and weighted normal (weight × area element × outward normal),
+/// structure of arrays (n entries each; padding entries must carry a zero normal).
+struct StressletSources {
+  const double* x = nullptr;
+  const double* y = nullptr;
+  const double* z = nullptr;
+  const double* vx = nullptr;
+  const double* vy = nullptr;
+  const double* vz = nullptr;
+  const double* nx = nullptr;
+  const double* ny = nullptr;
+  const double* nz = nullptr;
+  int n = 0;
+};
+
+/// @brief The double layer's all-pairs regular sum (double_layer.h): for every target i
+///     u_i = Σ_j (v_j − v_i)·T(x_j − x_i)·n_j     (add_stresslet),
+/// a source at zero distance contributing nothing. Three implementations of the one sum, as for the Stokeslet:
+///  - stresslet_sum_plain: the reference `omp simd` loop over sources (1/r by 1/std::sqrt), kept for tests;
+///  - stresslet_sum_fast: the SIMD tile of stokeslet_lanes.h (targets in lanes, sources broadcast, two target
+///    vectors per tile, 1/r as sum_fast's InvSqrt::Hybrid), in double (kFastRelativeBound against the plain one);
+///  - stresslet_sum_mixed: the same tile in float lanes with the sums in double (numerics.kernel_precision =
+///    "mixed", as sum_mixed): targets, densities, sources and normals rounded to float once per call, partial sums
+///    over kMixedBlock sources added in double. Accuracy: kStressletMixedRelativeBound.
+/// All overwrite u; OpenMP-parallel over targets; each target's sum independent of the thread count.
+void stresslet_sum_plain(const StressletTargets& t, const StressletSources& s, const Result& u);
+/// @brief See stresslet_sum_plain.
+void stresslet_sum_fast(const StressletTargets& t, const StressletSources& s, const Result& u);
+/// @brief See stresslet_sum_plain.
+void stresslet_sum_mixed(const StressletTargets& t, const StressletSources& s, const Result& u);
+
+/// @brief Contract of stresslet_sum_mixed against the double sum, as max_i |Δu_i| / max_i |u_i| over the targets of
+/// one evaluation (a node's own regular sum can be small where its neighbours' are not: the norm-wise measure).
+/// Measured (tests/solver/stokes/double_layer_test.cc, AVX-512): 1.4e-6 on a deformed sphere and 5e-7 to 8e-7 on
+/// a spheroid a/b = 2, the same at levels 2 and 3, and the same with float partial sums of 32 sources instead of
+/// kMixedBlock: not the float accumulation but the rounding of positions and densities (≈ 6e-8 absolute), which
+/// the stresslet feels more than the Stokeslet next to the target, where r·n = O(r²) and v − v(x0) = O(r) are
+/// differences of rounded numbers. The bound leaves a factor ≈ 3 to that. Against the operator's discretisation
+/// error on the sphere (solver/README.md §3b) the measured 1.4e-6 is 6e-4 of it on level 1, 1e-2 on level 2, 0.14
+/// to 0.22 on level 3 and comparable on level 4: on fine meshes prefer double (numerics.kernel_precision).
+inline constexpr double kStressletMixedRelativeBound = 5e-6;
+
 /// @brief Sources a target sums in float before the partial sum is added in double (sum_mixed).
 inline constexpr int kMixedBlock = 256;
 

@@ -10,7 +10,9 @@
 /// kHouseholderTerms (terms of the series that refines the estimate to full double accuracy); float lanes add
 /// Wide (the double lanes of the same instruction set) and widen_add (a float vector converted and added
 /// into two Wide vectors).
-/// The four lane types: Avx512d, Avx2d (sum_fast, sum_blocks) and Avx512f, Avx2f (sum_mixed).
+/// The four lane types: Avx512d, Avx2d (sum_fast, sum_blocks, stresslet_sum_fast) and Avx512f, Avx2f (sum_mixed,
+/// stresslet_sum_mixed). The double layer's tiles (stresslet_tile, stresslet_tile_mixed, below) restate
+/// kernel::add_stresslet in lanes; tests/solver/stokes/double_layer_test.cc compares them with it.
 ///
 /// Every lane type runs the same operations in the same order. What differs per instruction set is the 1/√
 /// estimate (14 bits with AVX-512, 12 with AVX2) and so the length of its refinement in double: an AVX-512 and
@@ -159,6 +161,7 @@ struct Constants {
   // Double: 1 and the series coefficients kC1..kC4. Float: one Newton step y (3 − r² y²)/2, 1/2 and 3.
   V one = L::set1(S(1)), c1 = L::set1(S(kC1)), c2 = L::set1(S(kC2)), c3 = L::set1(S(kC3)), c4 = L::set1(S(kC4));
   V half = L::set1(S(0.5)), three = L::set1(S(3));
+  V minus6 = L::set1(S(-6));  // the stresslet's factor
 };
 
 /// @brief 1/r for the lanes' r2 (0 where r2 = 0, NaN kept), refined or divided.
@@ -261,6 +264,111 @@ inline void tile_mixed(const float* tx, const float* ty, const float* tz, const 
   for (int j0 = 0; j0 < ns; j0 += kChunk) {
     for (int b = 0; b < B; ++b) UX[b] = UY[b] = UZ[b] = L::zero();
     add_sources<L, B, 1>(X, Y, Z, src, j0, std::min(ns, j0 + kChunk), c, UX, UY, UZ);
+    for (int b = 0; b < B; ++b) {
+      L::widen_add(UX[b], DX[2 * b], DX[2 * b + 1]);
+      L::widen_add(UY[b], DY[2 * b], DY[2 * b + 1]);
+      L::widen_add(UZ[b], DZ[2 * b], DZ[2 * b + 1]);
+    }
+  }
+  for (int b = 0; b < 2 * B; ++b) {
+    W::store(ux + W::kLanes * b, DX[b]);
+    W::store(uy + W::kLanes * b, DY[b]);
+    W::store(uz + W::kLanes * b, DZ[b]);
+  }
+}
+
+/// @brief u += −6 (d·r)(r·n) r / |r|⁵ for one vector of pairs, r = (rx, ry, rz) from the target to the source, d
+/// the density difference, n the weighted normal: kernel::add_stresslet (stokeslet.h) in lanes, the same
+/// operation order (the products grouped as there: (−6 (d·r)) (r·n), times (1/r²)² (1/r)).
+template <class L, bool kRefined>
+inline void add_stresslet_pairs(typename L::V rx, typename L::V ry, typename L::V rz, typename L::V dx,
+                                typename L::V dy, typename L::V dz, typename L::V nx, typename L::V ny,
+                                typename L::V nz, const Constants<L>& c, typename L::V& ux, typename L::V& uy,
+                                typename L::V& uz) {
+  using V = typename L::V;
+  const V r2 = L::fmadd(rz, rz, L::fmadd(ry, ry, L::mul(rx, rx)));
+  const V y = inv_r<L, kRefined>(r2, c);
+  const V y2 = L::mul(y, y);
+  const V dr = L::fmadd(dz, rz, L::fmadd(dy, ry, L::mul(dx, rx)));
+  const V rn = L::fmadd(nz, rz, L::fmadd(ny, ry, L::mul(nx, rx)));
+  const V s = L::mul(L::mul(L::mul(c.minus6, dr), rn), L::mul(L::mul(y2, y2), y));
+  ux = L::fmadd(s, rx, ux);
+  uy = L::fmadd(s, ry, uy);
+  uz = L::fmadd(s, rz, uz);
+}
+
+/// @brief The double layer's tile body: B target vectors (positions X, Y, Z and densities VX, VY, VZ) against the
+/// sources [j0, j1) (src = their x, y, z, vx, vy, vz, nx, ny, nz), one source broadcast at a time, accumulated
+/// into (UX, UY, UZ).
+template <class L, int B, int kMode>
+inline void add_stresslet_sources(const typename L::V (&X)[B], const typename L::V (&Y)[B],
+                                  const typename L::V (&Z)[B], const typename L::V (&VX)[B],
+                                  const typename L::V (&VY)[B], const typename L::V (&VZ)[B],
+                                  const typename L::Scalar* const (&src)[9], int j0, int j1, const Constants<L>& c,
+                                  typename L::V (&UX)[B], typename L::V (&UY)[B], typename L::V (&UZ)[B]) {
+  using V = typename L::V;
+  for (int j = j0; j < j1; ++j) {
+    const V sx = L::broadcast(src[0] + j), sy = L::broadcast(src[1] + j), sz = L::broadcast(src[2] + j);
+    const V svx = L::broadcast(src[3] + j), svy = L::broadcast(src[4] + j), svz = L::broadcast(src[5] + j);
+    const V nx = L::broadcast(src[6] + j), ny = L::broadcast(src[7] + j), nz = L::broadcast(src[8] + j);
+    for (int b = 0; b < B; ++b) {
+      const V rx = L::sub(sx, X[b]), ry = L::sub(sy, Y[b]), rz = L::sub(sz, Z[b]);
+      const V dx = L::sub(svx, VX[b]), dy = L::sub(svy, VY[b]), dz = L::sub(svz, VZ[b]);
+      if (refined<kMode>(b))
+        add_stresslet_pairs<L, true>(rx, ry, rz, dx, dy, dz, nx, ny, nz, c, UX[b], UY[b], UZ[b]);
+      else
+        add_stresslet_pairs<L, false>(rx, ry, rz, dx, dy, dz, nx, ny, nz, c, UX[b], UY[b], UZ[b]);
+    }
+  }
+}
+
+/// @brief B·L::kLanes double-layer targets (t = their x, y, z, vx, vy, vz) against all sources in double lanes L
+/// (stresslet_sum_fast's tile); u overwritten.
+template <class L, int B, int kMode>
+inline void stresslet_tile(const double* const (&t)[6], const double* const (&src)[9], int ns, double* ux,
+                           double* uy, double* uz) {
+  using V = typename L::V;
+  V X[B], Y[B], Z[B], VX[B], VY[B], VZ[B], UX[B], UY[B], UZ[B];
+  for (int b = 0; b < B; ++b) {
+    X[b] = L::load(t[0] + L::kLanes * b);
+    Y[b] = L::load(t[1] + L::kLanes * b);
+    Z[b] = L::load(t[2] + L::kLanes * b);
+    VX[b] = L::load(t[3] + L::kLanes * b);
+    VY[b] = L::load(t[4] + L::kLanes * b);
+    VZ[b] = L::load(t[5] + L::kLanes * b);
+    UX[b] = UY[b] = UZ[b] = L::zero();
+  }
+  const Constants<L> c;
+  add_stresslet_sources<L, B, kMode>(X, Y, Z, VX, VY, VZ, src, 0, ns, c, UX, UY, UZ);
+  for (int b = 0; b < B; ++b) {
+    L::store(ux + L::kLanes * b, UX[b]);
+    L::store(uy + L::kLanes * b, UY[b]);
+    L::store(uz + L::kLanes * b, UZ[b]);
+  }
+}
+
+/// @brief The same in float lanes L (stresslet_sum_mixed's tile): per block of kChunk sources the float sums are
+/// widened and added into double ones; u overwritten.
+template <class L, int B, int kChunk>
+inline void stresslet_tile_mixed(const float* const (&t)[6], const float* const (&src)[9], int ns, double* ux,
+                                 double* uy, double* uz) {
+  using V = typename L::V;
+  using W = typename L::Wide;
+  V X[B], Y[B], Z[B], VX[B], VY[B], VZ[B], UX[B], UY[B], UZ[B];
+  typename W::V DX[2 * B], DY[2 * B], DZ[2 * B];
+  for (int b = 0; b < B; ++b) {
+    X[b] = L::load(t[0] + L::kLanes * b);
+    Y[b] = L::load(t[1] + L::kLanes * b);
+    Z[b] = L::load(t[2] + L::kLanes * b);
+    VX[b] = L::load(t[3] + L::kLanes * b);
+    VY[b] = L::load(t[4] + L::kLanes * b);
+    VZ[b] = L::load(t[5] + L::kLanes * b);
+  }
+  for (int b = 0; b < 2 * B; ++b) DX[b] = DY[b] = DZ[b] = W::zero();
+  const Constants<L> c;
+  for (int j0 = 0; j0 < ns; j0 += kChunk) {
+    for (int b = 0; b < B; ++b) UX[b] = UY[b] = UZ[b] = L::zero();
+    add_stresslet_sources<L, B, 1>(X, Y, Z, VX, VY, VZ, src, j0, std::min(ns, j0 + kChunk), c, UX, UY, UZ);
     for (int b = 0; b < B; ++b) {
       L::widen_add(UX[b], DX[2 * b], DX[2 * b + 1]);
       L::widen_add(UY[b], DY[2 * b], DY[2 * b + 1]);

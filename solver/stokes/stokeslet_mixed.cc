@@ -115,7 +115,98 @@ void sum_mixed_tiles(const Targets& t, const Sources& s, const Result& u) {
   }
 }
 
+// The double layer's sum in float lanes (stresslet_sum_mixed): two target vectors per tile.
+struct StressletFloatSoA {
+  std::vector<float> x, y, z, vx, vy, vz, nx, ny, nz;
+};
+
+#if defined(__AVX512F__) || (defined(__AVX2__) && defined(__FMA__))
+#if defined(__AVX512F__)
+using StressletLanes = lanes::Avx512f;
+#else
+using StressletLanes = lanes::Avx2f;
+#endif
+constexpr int kStressletWidth = StressletLanes::kLanes * 2;
+inline void stresslet_tile_f(const float* const (&t)[6], const StressletFloatSoA& s, int ns, double* ux, double* uy,
+                             double* uz) {
+  lanes::stresslet_tile_mixed<StressletLanes, 2, kMixedBlock>(
+      t, {s.x.data(), s.y.data(), s.z.data(), s.vx.data(), s.vy.data(), s.vz.data(), s.nx.data(), s.ny.data(),
+          s.nz.data()},
+      ns, ux, uy, uz);
+}
+#else
+// Portable: the lanes as an inner loop the compiler vectorises, float terms, block sums in double.
+constexpr int kStressletWidth = 16;
+inline void stresslet_tile_f(const float* const (&t)[6], const StressletFloatSoA& s, int ns, double* ux, double* uy,
+                             double* uz) {
+  constexpr int W = kStressletWidth;
+  double dx_[W] = {}, dy_[W] = {}, dz_[W] = {};
+  for (int j0 = 0; j0 < ns; j0 += kMixedBlock) {
+    float ax[W] = {}, ay[W] = {}, az[W] = {};
+    for (int j = j0; j < std::min(ns, j0 + kMixedBlock); ++j) {
+#pragma omp simd
+      for (int l = 0; l < W; ++l) {
+        const float rx = s.x[j] - t[0][l], ry = s.y[j] - t[1][l], rz = s.z[j] - t[2][l];
+        const float r2 = rx * rx + ry * ry + rz * rz;
+        const float inv = r2 == 0.0f ? 0.0f : 1.0f / std::sqrt(r2);
+        add_stresslet(rx, ry, rz, s.vx[j] - t[3][l], s.vy[j] - t[4][l], s.vz[j] - t[5][l], s.nx[j], s.ny[j], s.nz[j],
+                      inv, ax[l], ay[l], az[l]);
+      }
+    }
+    for (int l = 0; l < W; ++l) {
+      dx_[l] += ax[l];
+      dy_[l] += ay[l];
+      dz_[l] += az[l];
+    }
+  }
+  for (int l = 0; l < W; ++l) {
+    ux[l] = dx_[l];
+    uy[l] = dy_[l];
+    uz[l] = dz_[l];
+  }
+}
+#endif
+
 }  // namespace
+
+void stresslet_sum_mixed(const StressletTargets& t, const StressletSources& s, const Result& u) {
+  if (t.n <= 0) return;
+  constexpr int W = kStressletWidth;
+  const int ntiles = (t.n + W - 1) / W, padded = ntiles * W;
+  // Float copies kept between calls (one set per calling thread), as in sum_mixed_tiles.
+  thread_local std::vector<float> tf[6];
+  thread_local StressletFloatSoA f;
+  const double* tin[6] = {t.x, t.y, t.z, t.vx, t.vy, t.vz};
+  for (int k = 0; k < 6; ++k) {
+    tf[k].resize(static_cast<std::size_t>(padded));
+    for (int i = 0; i < padded; ++i) tf[k][i] = static_cast<float>(tin[k][std::min(i, t.n - 1)]);
+  }
+  to_float(s.x, s.n, f.x);
+  to_float(s.y, s.n, f.y);
+  to_float(s.z, s.n, f.z);
+  to_float(s.vx, s.n, f.vx);
+  to_float(s.vy, s.n, f.vy);
+  to_float(s.vz, s.n, f.vz);
+  to_float(s.nx, s.n, f.nx);
+  to_float(s.ny, s.n, f.ny);
+  to_float(s.nz, s.n, f.nz);
+  // The OpenMP threads must see this thread's copies, not their own thread_local ones: plain locals.
+  const StressletFloatSoA& src = f;
+  const float* tp0[6] = {tf[0].data(), tf[1].data(), tf[2].data(), tf[3].data(), tf[4].data(), tf[5].data()};
+  const float* const* tpp = tp0;
+#pragma omp parallel for schedule(static)
+  for (int it = 0; it < ntiles; ++it) {
+    const int i0 = it * W;
+    alignas(64) double ox[W], oy[W], oz[W];
+    const float* const tp[6] = {tpp[0] + i0, tpp[1] + i0, tpp[2] + i0, tpp[3] + i0, tpp[4] + i0, tpp[5] + i0};
+    stresslet_tile_f(tp, src, s.n, ox, oy, oz);
+    for (int l = 0; l < W && i0 + l < t.n; ++l) {
+      u.x[i0 + l] = ox[l];
+      u.y[i0 + l] = oy[l];
+      u.z[i0 + l] = oz[l];
+    }
+  }
+}
 
 void sum_mixed(const Targets& t, const Sources& s, const Result& u) {
 #if defined(__AVX512F__)

@@ -106,11 +106,12 @@ TEST(CostModel, ACaseIsItsEvaluationsTimesAnEvaluation) {
   EXPECT_NEAR(CostModel::case_cost(longer, h), 2 * CostModel::case_cost(c, h), 1e-12 * CostModel::case_cost(c, h));
 }
 
-// A viscosity ratio: each evaluation adds the double layer's GMRES iterations (about one per decade of the
+// A viscosity ratio: each evaluation adds the double layer's applications (about 1.1 per decade of the
 // tolerance), and the softer membrane takes fewer evaluations (stiffness × 2/(1 + λ)). Checked against the
-// measured whole-case ratio of results/benchmarks.md, "Whole cases at a viscosity ratio": λ = 5 costs 5.2× λ = 1
-// at the default tolerance and 2.8× at 1e-4 (level 2, a/b = 2, Ca = 0.3, the main preset's numerics); the model
-// must hold both to within 40 % (it is a cost for ordering and the ETA, from constants measured elsewhere).
+// measured whole-case ratio of results/benchmarks.md, "The viscosity-ratio evaluation by phase": λ = 5 costs
+// 2.7× λ = 1 at the default tolerance and 2.2× at 1e-4 (level 2, a/b = 2, Ca = 0.3, the main preset's numerics);
+// the model must hold both to within 40 % (it is a cost for ordering and the ETA, from constants measured
+// elsewhere).
 TEST(CostModel, AViscosityRatioAddsTheDoubleLayersIterations) {
   config::CaseConfig c;
   c.level = 2;
@@ -123,16 +124,16 @@ TEST(CostModel, AViscosityRatioAddsTheDoubleLayersIterations) {
   const double h = mesh::min_node_spacing(m, m.nodes);
   config::CaseConfig five = c;
   five.viscosity_ratio = 5.0;
-  EXPECT_NEAR(CostModel::double_layer_applications(five), 8.0, 1e-12);
+  EXPECT_NEAR(CostModel::double_layer_applications(five), 8.8, 1e-12);
   EXPECT_LT(evaluations_per_unit_time(five, h), evaluations_per_unit_time(c, h));
   const double ratio = CostModel::case_cost(five, h) / CostModel::case_cost(c, h);
-  EXPECT_GT(ratio, 5.2 / 1.4);
-  EXPECT_LT(ratio, 5.2 * 1.4);
+  EXPECT_GT(ratio, 2.7 / 1.4);
+  EXPECT_LT(ratio, 2.7 * 1.4);
   five.viscosity_tolerance = 1e-4;
   const double loose = CostModel::case_cost(five, h) / CostModel::case_cost(c, h);
-  EXPECT_GT(loose, 2.8 / 1.4);
-  EXPECT_LT(loose, 2.8 * 1.4);
-  std::printf("model: λ = 5 case / λ = 1 case = %.2f at tolerance 1e-8 (measured 5.2), %.2f at 1e-4 (2.8)\n", ratio,
+  EXPECT_GT(loose, 2.2 / 1.4);
+  EXPECT_LT(loose, 2.2 * 1.4);
+  std::printf("model: λ = 5 case / λ = 1 case = %.2f at tolerance 1e-8 (measured 2.7), %.2f at 1e-4 (2.2)\n", ratio,
               loose);
 }
 

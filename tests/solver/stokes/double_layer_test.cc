@@ -186,6 +186,54 @@ TEST(DoubleLayer, SymmetricEvaluationsEqualTheFullEvaluation) {
   EXPECT_EQ((u1 - full.apply(x, v_odd)).cwiseAbs().maxCoeff(), 0.0);
 }
 
+// The regular all-pairs sum by its three implementations (stokeslet.h): the SIMD tile in double (the lanes of
+// stokeslet_lanes.h, restating kernel::add_stresslet) and in mixed precision against the plain loop over
+// add_stresslet, through the whole operator (the corrections are the same in all three), on a deformed sphere and
+// a P2 spheroid a/b = 2 with a generic density, levels 2 and 3. Norm-wise, max_i |Δu_i| / max_i |u_i| (a node's
+// own sum can nearly vanish).
+TEST(DoubleLayer, SimdTilesAgreeWithThePlainStressletSum) {
+  for (const int level : {2, 3})
+  for (const bool spheroid : {false, true}) {
+    const auto m = spheroid ? mesh::make_capsule_mesh(level, 2.0) : mesh::make_sphere_mesh(level);
+    const Matrix3Xd x = spheroid ? Matrix3Xd(m.nodes) : deformed_positions(m), v = smooth_density(x);
+    SingleLayerOptions plain_opt, fast_opt, mixed_opt;
+    plain_opt.symmetry = fast_opt.symmetry = mixed_opt.symmetry = Symmetry::Off;
+    plain_opt.kernel = KernelChoice::Plain;
+    mixed_opt.precision = KernelPrecision::Mixed;
+    DoubleLayer plain(m, plain_opt), fast(m, fast_opt), mixed(m, mixed_opt);
+    const Matrix3Xd up = plain.apply(x, v), uf = fast.apply(x, v), um = mixed.apply(x, v);
+    const double scale = up.cwiseAbs().maxCoeff();
+    const double df = (uf - up).cwiseAbs().maxCoeff() / scale, dm = (um - up).cwiseAbs().maxCoeff() / scale;
+    std::printf("  %s (%d nodes): fast tile %.2e, mixed %.2e of max |D[v]| from the plain sum (%s)\n",
+                spheroid ? "spheroid a/b = 2" : "deformed sphere", m.num_nodes(), df, dm, kernel::kernel_isa());
+    EXPECT_LT(df, kernel::kFastRelativeBound * 0.1);  // 1e-13
+    EXPECT_LT(dm, kernel::kStressletMixedRelativeBound);
+    EXPECT_GT(dm, 0.0);  // the mixed path is in use
+  }
+}
+
+// The lanes' stresslet against the scalar definition pair by pair, over distances from 1e-3 to 10: the tile of one
+// target and one source is the sum of that one term.
+TEST(DoubleLayer, LaneStressletIsTheScalarDefinition) {
+  const double tx[1] = {0.1}, ty[1] = {-0.2}, tz[1] = {0.3}, tvx[1] = {0.5}, tvy[1] = {-1.0}, tvz[1] = {0.25};
+  double worst = 0.0;
+  for (double dist = 1e-3; dist < 10.0; dist *= 1.7) {
+    const double sx[1] = {0.1 + 0.6 * dist}, sy[1] = {-0.2 - 0.48 * dist}, sz[1] = {0.3 + 0.64 * dist};
+    const double svx[1] = {0.7}, svy[1] = {-0.1}, svz[1] = {0.4}, snx[1] = {0.3}, sny[1] = {0.9}, snz[1] = {-0.2};
+    double ex = 0.0, ey = 0.0, ez = 0.0;
+    const double rx = sx[0] - tx[0], ry = sy[0] - ty[0], rz = sz[0] - tz[0];
+    kernel::add_stresslet(rx, ry, rz, svx[0] - tvx[0], svy[0] - tvy[0], svz[0] - tvz[0], snx[0], sny[0], snz[0],
+                          1.0 / std::sqrt(rx * rx + ry * ry + rz * rz), ex, ey, ez);
+    double ux[1], uy[1], uz[1];
+    kernel::stresslet_sum_fast({tx, ty, tz, tvx, tvy, tvz, 1}, {sx, sy, sz, svx, svy, svz, snx, sny, snz, 1},
+                               {ux, uy, uz});
+    const double e = std::hypot(ux[0] - ex, uy[0] - ey, uz[0] - ez) / std::hypot(ex, ey, ez);
+    worst = std::max(worst, e);
+  }
+  std::printf("  lane vs scalar stresslet, worst relative difference %.2e\n", worst);
+  EXPECT_LT(worst, 1e-13);
+}
+
 constexpr double kRatios[] = {0.05, 0.2, 1.0, 5.0, 20.0};
 
 TEST(SecondKindSolve, RigidMotionIsTheSolutionForEveryViscosityRatio) {

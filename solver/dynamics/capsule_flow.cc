@@ -46,7 +46,11 @@ CapsuleFlow::CapsuleFlow(const config::CaseConfig& c) : Ca_(c.capillary_number),
   if (c.viscosity_ratio != 1.0) {  // λ = 1: no second-kind solve, v = f (the path of every committed result)
     stokes::SecondKindOptions ko;
     ko.tolerance = c.viscosity_tolerance;
-    second_kind_ = std::make_unique<ViscosityContrast>(*mesh_, single_layer_->options(), c.viscosity_ratio, ko);
+    // The double layer integrates on the single layer's rules and symmetries, in its own precision
+    // (numerics.double_layer_precision).
+    stokes::SingleLayerOptions dl = single_layer_->options();
+    dl.precision = c.double_layer_precision == "mixed" ? stokes::KernelPrecision::Mixed : stokes::KernelPrecision::Double;
+    second_kind_ = std::make_unique<ViscosityContrast>(*mesh_, dl, c.viscosity_ratio, ko);
   }
   volume_correction_ = c.volume_correction;
   flux_rule_ = mesh::P2Tabulation::of_degree(6);

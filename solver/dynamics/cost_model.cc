@@ -34,7 +34,7 @@ double CostModel::evaluation_ms(const config::CaseConfig& config) {
   const double applications = double_layer_applications(config);
   if (applications == 0.0) return single;  // λ = 1: the single layer alone
   return single +
-         applications * double_layer_ms(config.level, symmetry(config), config.kernel_precision == "mixed");
+         applications * double_layer_ms(config.level, symmetry(config), config.double_layer_precision == "mixed");
 }
 
 double CostModel::double_layer_applications(const config::CaseConfig& config) {

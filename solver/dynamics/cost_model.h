@@ -42,8 +42,9 @@ enum class SceneSymmetry {
 ///
 ///     D(L) = kDoubleLayerPerSingleLayer · (kRegularSumMs · 16^(L−3) · p + kCorrectionsMs · 4^(L−3)) / σ
 ///
-/// (the double layer has the single layer's quadrature, symmetries and precision: p as above; its set-up per
-/// solve is spread over the applications in the constant). n_D = 0 at λ = 1.
+/// (the double layer has the single layer's quadrature and symmetries, its own precision: p = 1 /
+/// kMixedSumSpeedup with numerics.double_layer_precision = "mixed", else 1; its set-up per solve is spread over
+/// the applications in the constant). n_D = 0 at λ = 1.
 ///
 /// Not a prediction of seconds: periodic cases stop before t_end, the prestress adds stages along a run, and
 /// other machines share the work out differently (the AVX-512 kernel makes the all-pairs sum a smaller share).

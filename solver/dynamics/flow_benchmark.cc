@@ -202,9 +202,10 @@ FlowBenchReport bench_flow(const FlowBenchOptions& options) {
   const config::CaseConfig& c = options.scene;
   CapsuleFlow flow(c);
   std::unique_ptr<CapsuleFlow> in_double;
-  if (c.kernel_precision != "double") {
+  if (c.kernel_precision != "double" || c.double_layer_precision != "double") {
     config::CaseConfig cd = c;
     cd.kernel_precision = "double";
+    cd.double_layer_precision = "double";
     in_double = std::make_unique<CapsuleFlow>(cd);
   }
   std::unique_ptr<CapsuleFlow> equal_viscosity;
@@ -240,6 +241,7 @@ FlowBenchReport bench_flow(const FlowBenchOptions& options) {
   }
   if (in_double) {
     cc.kernel_precision = "double";
+    cc.double_layer_precision = "double";
     central_double = std::make_unique<CapsuleFlow>(cc);
   }
   report.scenes.push_back(measure_scene(central, central_double.get(), central_equal.get(),

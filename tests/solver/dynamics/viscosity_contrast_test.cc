@@ -84,6 +84,36 @@ TEST(ViscosityContrast, UnloadedSphereInShearMovesAsTheExactDrop) {
   }
 }
 
+// numerics.double_layer_precision reaches the double layer and nothing else: on a deformed a/b = 2 capsule at
+// λ = 5 the mixed double layer moves the velocity by the round-off of float pair terms (above 1e-12, below 1e-5
+// of max |v|), whichever precision the single layer has; and at λ = 1, where there is no double layer, the key
+// changes nothing, bitwise.
+TEST(ViscosityContrast, DoubleLayerPrecisionIsItsOwnKey) {
+  const auto velocity = [](double lambda, const std::string& single, const std::string& dl) {
+    config::CaseConfig c = make_case(2, 2.0, lambda);
+    c.kernel_precision = single;
+    c.double_layer_precision = dl;
+    CapsuleFlow flow(c);
+    Eigen::Matrix3Xd x = flow.reference();
+    for (int i = 0; i < x.cols(); ++i) x(0, i) *= 1.0 + 0.1 * x(1, i);  // a load and a general scene
+    Eigen::Matrix3Xd v;
+    flow.begin_step();
+    (void)flow.velocity(x, v);
+    return v;
+  };
+  const Eigen::Matrix3Xd dd = velocity(5.0, "double", "double"), dm = velocity(5.0, "double", "mixed");
+  const double scale = dd.cwiseAbs().maxCoeff(), moved = (dm - dd).cwiseAbs().maxCoeff() / scale;
+  std::printf("  λ = 5: mixed double layer moves the velocity by %.2e of max |v|\n", moved);
+  EXPECT_GT(moved, 1e-12);
+  EXPECT_LT(moved, 1e-5);
+  // With a mixed single layer: each key still moves v on its own.
+  const Eigen::Matrix3Xd md = velocity(5.0, "mixed", "double"), mm = velocity(5.0, "mixed", "mixed");
+  EXPECT_GT((mm - md).cwiseAbs().maxCoeff() / scale, 1e-12);
+  EXPECT_GT((md - dd).cwiseAbs().maxCoeff() / scale, 1e-12);
+  const Eigen::Matrix3Xd one_d = velocity(1.0, "double", "double"), one_m = velocity(1.0, "double", "mixed");
+  EXPECT_EQ((one_m - one_d).cwiseAbs().maxCoeff(), 0.0) << "λ = 1 has no double layer";
+}
+
 // Within a step the second solve of the same right-hand side starts from the first one's solution and needs no
 // iteration; begin_step forgets it (the next solve repeats the first bitwise); the statistics count the solves.
 TEST(ViscosityContrast, WarmStartLastsOneStep) {

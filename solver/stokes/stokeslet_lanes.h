@@ -245,25 +245,19 @@ inline void tile(const double* tx, const double* ty, const double* tz, const dou
   }
 }
 
-/// @brief B·L::kLanes targets against all sources in float lanes L (sum_mixed's tile): per block of kChunk
-/// sources the float sums are widened and added into double ones; u overwritten.
-template <class L, int B, int kChunk>
-inline void tile_mixed(const float* tx, const float* ty, const float* tz, const float* const (&src)[6], int ns,
-                       double* ux, double* uy, double* uz) {
+/// @brief The accumulation of a mixed tile: per block of kChunk sources, @p add_chunk(j0, j1, UX, UY, UZ) adds
+/// the pairs of sources [j0, j1) to float vectors started at zero, which are widened and added into double sums;
+/// the double sums are stored to u (overwritten). Shared by the Stokeslet's and the stresslet's mixed tiles.
+template <class L, int B, int kChunk, class AddChunk>
+inline void accumulate_mixed(int ns, AddChunk&& add_chunk, double* ux, double* uy, double* uz) {
   using V = typename L::V;
   using W = typename L::Wide;
-  V X[B], Y[B], Z[B], UX[B], UY[B], UZ[B];
+  V UX[B], UY[B], UZ[B];
   typename W::V DX[2 * B], DY[2 * B], DZ[2 * B];
-  for (int b = 0; b < B; ++b) {
-    X[b] = L::load(tx + L::kLanes * b);
-    Y[b] = L::load(ty + L::kLanes * b);
-    Z[b] = L::load(tz + L::kLanes * b);
-  }
   for (int b = 0; b < 2 * B; ++b) DX[b] = DY[b] = DZ[b] = W::zero();
-  const Constants<L> c;
   for (int j0 = 0; j0 < ns; j0 += kChunk) {
     for (int b = 0; b < B; ++b) UX[b] = UY[b] = UZ[b] = L::zero();
-    add_sources<L, B, 1>(X, Y, Z, src, j0, std::min(ns, j0 + kChunk), c, UX, UY, UZ);
+    add_chunk(j0, std::min(ns, j0 + kChunk), UX, UY, UZ);
     for (int b = 0; b < B; ++b) {
       L::widen_add(UX[b], DX[2 * b], DX[2 * b + 1]);
       L::widen_add(UY[b], DY[2 * b], DY[2 * b + 1]);
@@ -275,6 +269,24 @@ inline void tile_mixed(const float* tx, const float* ty, const float* tz, const 
     W::store(uy + W::kLanes * b, DY[b]);
     W::store(uz + W::kLanes * b, DZ[b]);
   }
+}
+
+/// @brief B·L::kLanes targets against all sources in float lanes L (sum_mixed's tile): per block of kChunk
+/// sources the float sums are widened and added into double ones; u overwritten.
+template <class L, int B, int kChunk>
+inline void tile_mixed(const float* tx, const float* ty, const float* tz, const float* const (&src)[6], int ns,
+                       double* ux, double* uy, double* uz) {
+  using V = typename L::V;
+  V X[B], Y[B], Z[B];
+  for (int b = 0; b < B; ++b) {
+    X[b] = L::load(tx + L::kLanes * b);
+    Y[b] = L::load(ty + L::kLanes * b);
+    Z[b] = L::load(tz + L::kLanes * b);
+  }
+  const Constants<L> c;
+  accumulate_mixed<L, B, kChunk>(
+      ns, [&](int j0, int j1, V(&UX)[B], V(&UY)[B], V(&UZ)[B]) { add_sources<L, B, 1>(X, Y, Z, src, j0, j1, c, UX, UY, UZ); },
+      ux, uy, uz);
 }
 
 /// @brief u += −6 (d·r)(r·n) r / |r|⁵ for one vector of pairs, r = (rx, ry, rz) from the target to the source, d
@@ -353,9 +365,7 @@ template <class L, int B, int kChunk>
 inline void stresslet_tile_mixed(const float* const (&t)[6], const float* const (&src)[9], int ns, double* ux,
                                  double* uy, double* uz) {
   using V = typename L::V;
-  using W = typename L::Wide;
-  V X[B], Y[B], Z[B], VX[B], VY[B], VZ[B], UX[B], UY[B], UZ[B];
-  typename W::V DX[2 * B], DY[2 * B], DZ[2 * B];
+  V X[B], Y[B], Z[B], VX[B], VY[B], VZ[B];
   for (int b = 0; b < B; ++b) {
     X[b] = L::load(t[0] + L::kLanes * b);
     Y[b] = L::load(t[1] + L::kLanes * b);
@@ -364,22 +374,13 @@ inline void stresslet_tile_mixed(const float* const (&t)[6], const float* const 
     VY[b] = L::load(t[4] + L::kLanes * b);
     VZ[b] = L::load(t[5] + L::kLanes * b);
   }
-  for (int b = 0; b < 2 * B; ++b) DX[b] = DY[b] = DZ[b] = W::zero();
   const Constants<L> c;
-  for (int j0 = 0; j0 < ns; j0 += kChunk) {
-    for (int b = 0; b < B; ++b) UX[b] = UY[b] = UZ[b] = L::zero();
-    add_stresslet_sources<L, B, 1>(X, Y, Z, VX, VY, VZ, src, j0, std::min(ns, j0 + kChunk), c, UX, UY, UZ);
-    for (int b = 0; b < B; ++b) {
-      L::widen_add(UX[b], DX[2 * b], DX[2 * b + 1]);
-      L::widen_add(UY[b], DY[2 * b], DY[2 * b + 1]);
-      L::widen_add(UZ[b], DZ[2 * b], DZ[2 * b + 1]);
-    }
-  }
-  for (int b = 0; b < 2 * B; ++b) {
-    W::store(ux + W::kLanes * b, DX[b]);
-    W::store(uy + W::kLanes * b, DY[b]);
-    W::store(uz + W::kLanes * b, DZ[b]);
-  }
+  accumulate_mixed<L, B, kChunk>(
+      ns,
+      [&](int j0, int j1, V(&UX)[B], V(&UY)[B], V(&UZ)[B]) {
+        add_stresslet_sources<L, B, 1>(X, Y, Z, VX, VY, VZ, src, j0, j1, c, UX, UY, UZ);
+      },
+      ux, uy, uz);
 }
 
 /// @brief One target (broadcast) against `count` blocks of `length` sources in lanes (sum_blocks), refined 1/r;

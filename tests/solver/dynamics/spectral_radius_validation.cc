@@ -1,6 +1,6 @@
 // Calibration of the RKC stage count (label `validation`; minutes at level 3): the stiffness estimate
 // membrane_spectral_radius against the power-iteration truth estimate_spectral_radius on states along runs
-// of the issue-13 reference cases (shear flow from rest, RKC at the automatic dt), at γ̇t = 0, 1, 2, 3, 4,
+// of the reference cases of results/time_steps (shear flow from rest, RKC at the automatic dt), at γ̇t = 0, 1, 2, 3, 4,
 // levels 2 and 3. Prints one row per state (results/time_steps/spectral_radius.md quotes them) and asserts
 // what the stage choice relies on: the estimate never falls below the truth, and the estimate with the
 // RKC safety factor keeps a margin over it.

@@ -334,13 +334,12 @@ inline void add_stresslet_sources(const typename L::V (&X)[B], const typename L:
   }
 }
 
-/// @brief B·L::kLanes double-layer targets (t = their x, y, z, vx, vy, vz) against all sources in double lanes L
-/// (stresslet_sum_fast's tile); u overwritten.
-template <class L, int B, int kMode>
-inline void stresslet_tile(const double* const (&t)[6], const double* const (&src)[9], int ns, double* ux,
-                           double* uy, double* uz) {
-  using V = typename L::V;
-  V X[B], Y[B], Z[B], VX[B], VY[B], VZ[B], UX[B], UY[B], UZ[B];
+/// @brief The B vectors of a double-layer tile's targets: positions t[0..2] and densities t[3..5], L::kLanes
+/// targets per vector (stresslet_tile and stresslet_tile_mixed).
+template <class L, int B>
+inline void load_stresslet_targets(const typename L::Scalar* const (&t)[6], typename L::V (&X)[B],
+                                   typename L::V (&Y)[B], typename L::V (&Z)[B], typename L::V (&VX)[B],
+                                   typename L::V (&VY)[B], typename L::V (&VZ)[B]) {
   for (int b = 0; b < B; ++b) {
     X[b] = L::load(t[0] + L::kLanes * b);
     Y[b] = L::load(t[1] + L::kLanes * b);
@@ -348,8 +347,18 @@ inline void stresslet_tile(const double* const (&t)[6], const double* const (&sr
     VX[b] = L::load(t[3] + L::kLanes * b);
     VY[b] = L::load(t[4] + L::kLanes * b);
     VZ[b] = L::load(t[5] + L::kLanes * b);
-    UX[b] = UY[b] = UZ[b] = L::zero();
   }
+}
+
+/// @brief B·L::kLanes double-layer targets (t = their x, y, z, vx, vy, vz) against all sources in double lanes L
+/// (stresslet_sum_fast's tile); u overwritten.
+template <class L, int B, int kMode>
+inline void stresslet_tile(const double* const (&t)[6], const double* const (&src)[9], int ns, double* ux,
+                           double* uy, double* uz) {
+  using V = typename L::V;
+  V X[B], Y[B], Z[B], VX[B], VY[B], VZ[B], UX[B], UY[B], UZ[B];
+  load_stresslet_targets<L, B>(t, X, Y, Z, VX, VY, VZ);
+  for (int b = 0; b < B; ++b) UX[b] = UY[b] = UZ[b] = L::zero();
   const Constants<L> c;
   add_stresslet_sources<L, B, kMode>(X, Y, Z, VX, VY, VZ, src, 0, ns, c, UX, UY, UZ);
   for (int b = 0; b < B; ++b) {
@@ -366,14 +375,7 @@ inline void stresslet_tile_mixed(const float* const (&t)[6], const float* const 
                                  double* uy, double* uz) {
   using V = typename L::V;
   V X[B], Y[B], Z[B], VX[B], VY[B], VZ[B];
-  for (int b = 0; b < B; ++b) {
-    X[b] = L::load(t[0] + L::kLanes * b);
-    Y[b] = L::load(t[1] + L::kLanes * b);
-    Z[b] = L::load(t[2] + L::kLanes * b);
-    VX[b] = L::load(t[3] + L::kLanes * b);
-    VY[b] = L::load(t[4] + L::kLanes * b);
-    VZ[b] = L::load(t[5] + L::kLanes * b);
-  }
+  load_stresslet_targets<L, B>(t, X, Y, Z, VX, VY, VZ);
   const Constants<L> c;
   accumulate_mixed<L, B, kChunk>(
       ns,

@@ -19,6 +19,28 @@ void to_float(const double* in, int n, std::vector<float>& out) {
   for (int i = 0; i < n; ++i) out[i] = static_cast<float>(in[i]);
 }
 
+// The portable tiles' accumulation (without the SIMD lane types): per block of kMixedBlock sources,
+// add_chunk(j0, j1, ax, ay, az) adds the pairs of sources [j0, j1) to W float sums started at zero, which are
+// added into double ones; u overwritten. The float-lane counterpart is lanes::accumulate_mixed.
+template <int W, class AddChunk>
+inline void accumulate_portable(int ns, AddChunk&& add_chunk, double* ux, double* uy, double* uz) {
+  double dx_[W] = {}, dy_[W] = {}, dz_[W] = {};
+  for (int j0 = 0; j0 < ns; j0 += kMixedBlock) {
+    float ax[W] = {}, ay[W] = {}, az[W] = {};
+    add_chunk(j0, std::min(ns, j0 + kMixedBlock), ax, ay, az);
+    for (int l = 0; l < W; ++l) {
+      dx_[l] += ax[l];
+      dy_[l] += ay[l];
+      dz_[l] += az[l];
+    }
+  }
+  for (int l = 0; l < W; ++l) {
+    ux[l] = dx_[l];
+    uy[l] = dy_[l];
+    uz[l] = dz_[l];
+  }
+}
+
 #if defined(__AVX512F__) || (defined(__AVX2__) && defined(__FMA__))
 // kBlock vectors of L's float lanes of targets against all sources; per block of kMixedBlock sources the float
 // sums are added into double ones (lanes::tile_mixed).
@@ -53,22 +75,13 @@ constexpr int kBlock8 = 2;
 inline void tile8(const float* tx, const float* ty, const float* tz, const FloatSoA& s, int ns, double* ux,
                   double* uy, double* uz) {
   constexpr int W = kLanes8 * kBlock8;
-  double dx_[W] = {}, dy_[W] = {}, dz_[W] = {};
-  for (int j0 = 0; j0 < ns; j0 += kMixedBlock) {
-    float ax[W] = {}, ay[W] = {}, az[W] = {};
-    add_sources_to_lanes<float, W>(tx, ty, tz, s.x.data(), s.y.data(), s.z.data(), s.qx.data(), s.qy.data(),
-                                   s.qz.data(), j0, std::min(ns, j0 + kMixedBlock), ax, ay, az);
-    for (int l = 0; l < W; ++l) {
-      dx_[l] += ax[l];
-      dy_[l] += ay[l];
-      dz_[l] += az[l];
-    }
-  }
-  for (int l = 0; l < W; ++l) {
-    ux[l] = dx_[l];
-    uy[l] = dy_[l];
-    uz[l] = dz_[l];
-  }
+  accumulate_portable<W>(
+      ns,
+      [&](int j0, int j1, float* ax, float* ay, float* az) {
+        add_sources_to_lanes<float, W>(tx, ty, tz, s.x.data(), s.y.data(), s.z.data(), s.qx.data(), s.qy.data(),
+                                       s.qz.data(), j0, j1, ax, ay, az);
+      },
+      ux, uy, uz);
 }
 #endif
 
@@ -140,30 +153,21 @@ constexpr int kStressletWidth = 16;
 inline void stresslet_tile_f(const float* const (&t)[6], const StressletFloatSoA& s, int ns, double* ux, double* uy,
                              double* uz) {
   constexpr int W = kStressletWidth;
-  double dx_[W] = {}, dy_[W] = {}, dz_[W] = {};
-  for (int j0 = 0; j0 < ns; j0 += kMixedBlock) {
-    float ax[W] = {}, ay[W] = {}, az[W] = {};
-    for (int j = j0; j < std::min(ns, j0 + kMixedBlock); ++j) {
+  accumulate_portable<W>(
+      ns,
+      [&](int j0, int j1, float* ax, float* ay, float* az) {
+        for (int j = j0; j < j1; ++j) {
 #pragma omp simd
-      for (int l = 0; l < W; ++l) {
-        const float rx = s.x[j] - t[0][l], ry = s.y[j] - t[1][l], rz = s.z[j] - t[2][l];
-        const float r2 = rx * rx + ry * ry + rz * rz;
-        const float inv = r2 == 0.0f ? 0.0f : 1.0f / std::sqrt(r2);
-        add_stresslet(rx, ry, rz, s.vx[j] - t[3][l], s.vy[j] - t[4][l], s.vz[j] - t[5][l], s.nx[j], s.ny[j], s.nz[j],
-                      inv, ax[l], ay[l], az[l]);
-      }
-    }
-    for (int l = 0; l < W; ++l) {
-      dx_[l] += ax[l];
-      dy_[l] += ay[l];
-      dz_[l] += az[l];
-    }
-  }
-  for (int l = 0; l < W; ++l) {
-    ux[l] = dx_[l];
-    uy[l] = dy_[l];
-    uz[l] = dz_[l];
-  }
+          for (int l = 0; l < W; ++l) {
+            const float rx = s.x[j] - t[0][l], ry = s.y[j] - t[1][l], rz = s.z[j] - t[2][l];
+            const float r2 = rx * rx + ry * ry + rz * rz;
+            const float inv = r2 == 0.0f ? 0.0f : 1.0f / std::sqrt(r2);
+            add_stresslet(rx, ry, rz, s.vx[j] - t[3][l], s.vy[j] - t[4][l], s.vz[j] - t[5][l], s.nx[j], s.ny[j],
+                          s.nz[j], inv, ax[l], ay[l], az[l]);
+          }
+        }
+      },
+      ux, uy, uz);
 }
 #endif
 

@@ -146,9 +146,8 @@ void DoubleLayer::make_correction_slots() {
 void DoubleLayer::prepare_corrections(const Eigen::Matrix3Xd& x) {
   // The geometry of every point of the regular rule (and of the near rule) on x; the densities are laid out per
   // apply (layout_density).
-  const Eigen::Matrix3Xd zero = Eigen::Matrix3Xd::Zero(3, x.cols());
-  layout_normal_points(regular_, topo_.elements, x, zero, sources_);
-  if (!near_rule_.empty()) layout_normal_points(near_rule_, topo_.elements, x, zero, near_points_);
+  layout_normal_points(regular_, topo_.elements, x, sources_);
+  if (!near_rule_.empty()) layout_normal_points(near_rule_, topo_.elements, x, near_points_);
   const int nq = static_cast<int>(regular_.size()), nr = static_cast<int>(near_rule_.size());
   const int nt = static_cast<int>(targets_.size());
   // The targets' rows, in targets_ order.

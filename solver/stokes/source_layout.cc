@@ -71,36 +71,29 @@ void layout_points(const std::vector<mesh::P2Point>& rule, const std::vector<std
 }
 
 void layout_normal_points(const std::vector<mesh::P2Point>& rule, const std::vector<std::array<int, 6>>& elements,
-                          const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v, NormalSourceArrays& out) {
+                          const Eigen::Matrix3Xd& x, NormalSourceArrays& out) {
   const int ne = static_cast<int>(elements.size()), nq = static_cast<int>(rule.size());
-  for (auto* a : {&out.x, &out.y, &out.z, &out.vx, &out.vy, &out.vz, &out.nx, &out.ny, &out.nz})
+  for (auto* a : {&out.x, &out.y, &out.z, &out.nx, &out.ny, &out.nz})
     a->resize(static_cast<std::size_t>(ne) * static_cast<std::size_t>(nq));
   double* pos[3] = {out.x.data(), out.y.data(), out.z.data()};
-  double* den[3] = {out.vx.data(), out.vy.data(), out.vz.data()};
   double* nrm[3] = {out.nx.data(), out.ny.data(), out.nz.data()};
-  // O(N) per evaluation, against the O(N²) regular sum: the element geometry through the monomial helpers of
+  // O(N) per surface, against the O(N²) regular sum: the element geometry through the monomial helpers of
   // mesh/p2_element.h, in a scalar loop.
 #pragma omp parallel for schedule(static)
   for (int e = 0; e < ne; ++e) {
-    double X[6][3], V[6][3], C[6][3], D[6][3];
+    double X[6][3], C[6][3];
     for (int a = 0; a < 6; ++a)
-      for (int c = 0; c < 3; ++c) {
-        X[a][c] = x(c, elements[e][a]);
-        V[a][c] = v(c, elements[e][a]);
-      }
+      for (int c = 0; c < 3; ++c) X[a][c] = x(c, elements[e][a]);
     mesh::p2_monomials3(X, C);
-    mesh::p2_monomials3(V, D);
     for (int k = 0; k < nq; ++k) {
-      double p[3], g1[3], g2[3], vv[3];
+      double p[3], g1[3], g2[3];
       mesh::p2_monomial_geometry(C, rule[k].xi, rule[k].eta, p, g1, g2);
-      mesh::p2_monomial_value(D, rule[k].xi, rule[k].eta, vv);
       const double w = rule[k].w;
       const double n[3] = {w * (g1[1] * g2[2] - g1[2] * g2[1]), w * (g1[2] * g2[0] - g1[0] * g2[2]),
                            w * (g1[0] * g2[1] - g1[1] * g2[0])};
       const std::size_t j = static_cast<std::size_t>(e) * nq + k;
       for (int c = 0; c < 3; ++c) {
         pos[c][j] = p[c];
-        den[c][j] = vv[c];
         nrm[c][j] = n[c];
       }
     }

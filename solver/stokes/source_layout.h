@@ -59,10 +59,11 @@ struct NormalSourceArrays {
   AlignedVector x, y, z, vx, vy, vz, nx, ny, nz;
 };
 
-/// @brief The points of `rule` on every element, element-major (element e's points at [e·nq, e·nq + nq)), as
-/// double-layer sources: position, density v and weighted normal. No padding. OpenMP-parallel over elements.
+/// @brief The geometry of the points of `rule` on every element, element-major (element e's points at [e·nq,
+/// e·nq + nq)), as double-layer sources: position and weighted normal (the density arrays are left to
+/// layout_density, which fills them per application). No padding. OpenMP-parallel over elements.
 void layout_normal_points(const std::vector<mesh::P2Point>& rule, const std::vector<std::array<int, 6>>& elements,
-                          const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v, NormalSourceArrays& out);
+                          const Eigen::Matrix3Xd& x, NormalSourceArrays& out);
 
 /// @brief The density part of layout_normal_points alone: out.vx, vy, vz at the points of `rule` on every element
 /// (the P2 interpolant Σ_a N_a v_a), element-major; positions and normals are left as they are (the double layer

@@ -166,7 +166,7 @@ struct StressletSources {
 ///  - stresslet_sum_plain: the reference `omp simd` loop over sources (1/r by 1/std::sqrt), kept for tests;
 ///  - stresslet_sum_fast: the SIMD tile of stokeslet_lanes.h (targets in lanes, sources broadcast, two target
 ///    vectors per tile, 1/r as sum_fast's InvSqrt::Hybrid), in double (kFastRelativeBound against the plain one);
-///  - stresslet_sum_mixed: the same tile in float lanes with the sums in double (numerics.kernel_precision =
+///  - stresslet_sum_mixed: the same tile in float lanes with the sums in double (numerics.double_layer_precision =
 ///    "mixed", as sum_mixed): targets, densities, sources and normals rounded to float once per call, partial sums
 ///    over kMixedBlock sources added in double. Accuracy: kStressletMixedRelativeBound.
 /// All overwrite u; OpenMP-parallel over targets; each target's sum independent of the thread count.

@@ -25,13 +25,12 @@
 ///   perpendicular to p gives δ = 0 exactly (T is then that rotation, so T u = u′);
 /// - for a rigid body turning at angular velocity ω the spin rate tends, as the step shrinks, to ω · p, the
 ///   component of ω along the axis (the transport's angular velocity is p × ṗ = ω − (ω·p) p, the rest of ω turns
-///   u about p): the "spin" of the third Euler angle, in a form that has no singularity when the axis crosses a
-///   coordinate direction. A rigid spheroid with its axis along the vorticity x3 (ω = −½ γ̇ e3 for
-///   v∞ = (γ̇ x2, 0, 0)) spins at −½ γ̇.
-/// For a deforming membrane the spin is the turn of one material point: over one revolution of a tank-treading
-/// membrane it is exactly 2π, while within a revolution its rate follows the point along the non-circular
-/// section (faster where the section is narrow), so rates are best read as means over whole revolutions or long
-/// windows.
+///   u about p): the body's twist about its own axis, with no angle of a fixed frame that could become singular
+///   when the axis crosses a coordinate direction. A rigid spheroid with its axis along the vorticity x3
+///   (ω = −½ γ̇ e3 for v∞ = (γ̇ x2, 0, 0)) spins at −½ γ̇.
+/// For a deforming membrane the spin is the turn of one material point: over one revolution of a membrane
+/// tank-treading about a fixed axis (rolling) it is exactly 2π, while within a revolution its rate follows the
+/// point along the non-circular section, so rates are best read as means over whole revolutions or long windows.
 ///
 /// Degenerate cases give NaN, and once NaN the running sum stays NaN (the turn through a step that could not be
 /// measured is lost, and a later value would be wrong by it): a mesh without pole or equator nodes; poles that

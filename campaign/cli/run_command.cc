@@ -97,8 +97,9 @@ int run_command(const std::vector<std::string>& args) {
     if (config.tilt != 0.0 || r.final_tilt != 0.0)  // a case off the plane (an in-plane one prints as before)
       std::fprintf(stderr,
                    "# orientation: started at tilt %.4g deg, azimuth %.4g deg; final tilt %.4g deg, tilt growth rate "
-                   "%+.4g +- %.2g per unit shear time\n",
-                   config.tilt, config.azimuth, r.final_tilt, r.tilt_growth_rate, r.tilt_growth_rate_error);
+                   "%+.4g +- %.2g per unit shear time; membrane spin about the axis %+.4g rad per unit shear time\n",
+                   config.tilt, config.azimuth, r.final_tilt, r.tilt_growth_rate, r.tilt_growth_rate_error,
+                   r.final_spin_rate);
     std::fprintf(stderr, "# phases: membrane %.1f s, load %.1f s, boundary integral %.1f s\n", r.membrane_s, r.load_s,
                  r.stokes_s);
     std::fprintf(stderr,

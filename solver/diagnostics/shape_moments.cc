@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Eigenvalues>
+
 #include "solver/mesh/p2_tabulation.h"
 
 namespace capsim::diagnostics {
@@ -70,6 +72,30 @@ EllipsoidOfInertia ellipsoid_of_inertia(const ShapeMoments& moments) {
   el.theta = 0.5 * std::atan2(2.0 * m12, m11 - m22);
   // atan2(−0.0, x < 0) = −π: a long axis along x2 with a round-off negative zero M12 would give −π/2.
   if (el.theta <= -0.5 * std::numbers::pi) el.theta += std::numbers::pi;
+  return el;
+}
+
+EllipsoidOfInertia3D ellipsoid_of_inertia_3d(const ShapeMoments& moments) {
+  const double V = moments.volume;
+  if (!(V > 0)) throw std::invalid_argument("ellipsoid_of_inertia_3d: volume is not positive");
+  if (!moments.second_moment.allFinite()) throw std::invalid_argument("ellipsoid_of_inertia_3d: moments not finite");
+  // Eigenvalues in increasing order, orthonormal eigenvectors as columns.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(moments.second_moment);
+  EllipsoidOfInertia3D el;
+  std::array<double, 3> L{};
+  for (int k = 0; k < 3; ++k) {
+    const int j = 2 - k;  // La is the largest eigenvalue
+    L[k] = std::sqrt(5.0 * std::max(eig.eigenvalues()(j), 0.0) / V);
+    Eigen::Vector3d e = eig.eigenvectors().col(j).normalized();
+    // The first component that is not round-off decides the sign (the header says why 1e-9).
+    constexpr double kZero = 1e-9;
+    const double decider = std::abs(e.x()) > kZero ? e.x() : std::abs(e.y()) > kZero ? e.y() : e.z();
+    if (decider < 0) e = -e;
+    el.axes[k] = e;
+  }
+  el.La = L[0];
+  el.Lb = L[1];
+  el.Lc = L[2];
   return el;
 }
 

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
 
 #include "solver/diagnostics/shape_moments.h"
 
@@ -29,6 +31,15 @@ StepRecord measure_step(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x
   r.axis = ax.axis;
   r.axis_tilt = ax.tilt;
   r.axis_azimuth = ax.azimuth;
+  const EllipsoidOfInertia3D el3 = ellipsoid_of_inertia_3d(m);
+  r.La = el3.La;
+  r.Lb = el3.Lb;
+  r.Lc = el3.Lc;
+  for (int k = 0; k < 3; ++k) {
+    r.ea[k] = el3.axes[0](k);
+    r.eb[k] = el3.axes[1](k);
+    r.ec[k] = el3.axes[2](k);
+  }
   return r;
 }
 
@@ -90,26 +101,62 @@ void TimeSeries::push_back(const StepRecord& r) {
   axis_x3.push_back(r.axis[2]);
   axis_tilt.push_back(r.axis_tilt);
   axis_azimuth.push_back(r.axis_azimuth);
+  La.push_back(r.La);
+  Lb.push_back(r.Lb);
+  Lc.push_back(r.Lc);
+  for (auto [col, v] : {std::pair{&ea_x1, r.ea[0]}, std::pair{&ea_x2, r.ea[1]}, std::pair{&ea_x3, r.ea[2]},
+                        std::pair{&eb_x1, r.eb[0]}, std::pair{&eb_x2, r.eb[1]}, std::pair{&eb_x3, r.eb[2]},
+                        std::pair{&ec_x1, r.ec[0]}, std::pair{&ec_x2, r.ec[1]}, std::pair{&ec_x3, r.ec[2]}})
+    col->push_back(v);
+  spin.push_back(r.spin);
 }
 
 StepRecord TimeSeries::at(std::size_t i) const {
   if (i >= size()) throw std::out_of_range("TimeSeries::at: index out of range");
-  return {t[i], D12[i], L1[i], L2[i], theta[i], tau_min[i], volume[i], area[i], P[i], bending_energy[i],
-          max_bending_moment[i], {axis_x1[i], axis_x2[i], axis_x3[i]}, axis_tilt[i], axis_azimuth[i]};
+  StepRecord r;
+  r.t = t[i];
+  r.D12 = D12[i];
+  r.L1 = L1[i];
+  r.L2 = L2[i];
+  r.theta = theta[i];
+  r.tau_min = tau_min[i];
+  r.volume = volume[i];
+  r.area = area[i];
+  r.P = P[i];
+  r.bending_energy = bending_energy[i];
+  r.max_bending_moment = max_bending_moment[i];
+  r.axis = {axis_x1[i], axis_x2[i], axis_x3[i]};
+  r.axis_tilt = axis_tilt[i];
+  r.axis_azimuth = axis_azimuth[i];
+  r.La = La[i];
+  r.Lb = Lb[i];
+  r.Lc = Lc[i];
+  r.ea = {ea_x1[i], ea_x2[i], ea_x3[i]};
+  r.eb = {eb_x1[i], eb_x2[i], eb_x3[i]};
+  r.ec = {ec_x1[i], ec_x2[i], ec_x3[i]};
+  r.spin = spin[i];
+  return r;
 }
 
 void TimeSeries::truncate(std::size_t n) {
   if (n >= size()) return;
-  for (auto* c : {&t, &D12, &L1, &L2, &theta, &tau_min, &volume, &area, &bending_energy, &max_bending_moment, &axis_x1,
-                 &axis_x2, &axis_x3, &axis_tilt, &axis_azimuth})
-    c->resize(n);
+  for (auto* c : scalar_columns()) c->resize(n);
   P.resize(n);
+}
+
+bool operator==(const TimeSeries& a, const TimeSeries& b) {
+  auto same = [](const auto& u, const auto& v) {
+    return u.size() == v.size() && (u.empty() || std::memcmp(u.data(), v.data(), sizeof(u[0]) * u.size()) == 0);
+  };
+  const auto ca = a.scalar_columns(), cb = b.scalar_columns();
+  for (std::size_t k = 0; k < ca.size(); ++k)
+    if (!same(*ca[k], *cb[k])) return false;
+  return same(a.P, b.P);
 }
 
 bool TimeSeries::consistent() const {
   const std::size_t n = t.size();
-  for (const auto* c : {&D12, &L1, &L2, &theta, &tau_min, &volume, &area, &bending_energy, &max_bending_moment, &axis_x1,
-                        &axis_x2, &axis_x3, &axis_tilt, &axis_azimuth})
+  for (const auto* c : scalar_columns())
     if (c->size() != n) return false;
   return P.size() == n;
 }

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -30,9 +31,18 @@ struct StepRecord {
   std::array<double, 3> axis{};
   double axis_tilt = 0;     ///< angle of the material axis out of the shear plane, asin |axis_3|, degrees [0, 90]
   double axis_azimuth = 0;  ///< angle of its projection on the shear plane from x1 toward x2, as a line: (−90, 90] degrees
+  /// The 3D ellipsoid of inertia (EllipsoidOfInertia3D): semi-axes La ≥ Lb ≥ Lc, units ℓ, and their unit
+  /// directions (x1 component positive, see there).
+  double La = 0, Lb = 0, Lc = 0;
+  std::array<double, 3> ea{}, eb{}, ec{};
+  /// The membrane's rotation about the material axis since the start, radians, counter-clockwise about `axis`
+  /// (diagnostics/membrane_spin.h). Not measured by measure_step (it accumulates over the steps): NaN there, set
+  /// by the caller with advance_spin.
+  double spin = std::numeric_limits<double>::quiet_NaN();
 };
 
-/// @brief Measure everything but τmin (which the membrane provides) on positions x at time t.
+/// @brief Measure everything but τmin (which the membrane provides) and the spin (which needs the state before) on
+/// positions x at time t.
 /// @param p_node the node chosen by choose_material_point at the start of the case.
 StepRecord measure_step(const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x, double t, int p_node,
                         double tau_min);
@@ -52,6 +62,23 @@ struct TimeSeries {
   std::vector<std::array<double, 3>> P;
   std::vector<double> bending_energy, max_bending_moment;
   std::vector<double> axis_x1, axis_x2, axis_x3, axis_tilt, axis_azimuth;
+  std::vector<double> La, Lb, Lc, ea_x1, ea_x2, ea_x3, eb_x1, eb_x2, eb_x3, ec_x1, ec_x2, ec_x3, spin;
+
+ private:
+  template <class Self>
+  static auto columns_of(Self& s) {
+    return std::array{&s.t,       &s.D12,     &s.L1,      &s.L2,      &s.theta,   &s.tau_min, &s.volume,
+                      &s.area,    &s.bending_energy,      &s.max_bending_moment,  &s.axis_x1, &s.axis_x2,
+                      &s.axis_x3, &s.axis_tilt, &s.axis_azimuth, &s.La, &s.Lb,    &s.Lc,      &s.ea_x1,
+                      &s.ea_x2,   &s.ea_x3,   &s.eb_x1,   &s.eb_x2,   &s.eb_x3,   &s.ec_x1,   &s.ec_x2,
+                      &s.ec_x3,   &s.spin};
+  }
+
+ public:
+  /// @brief Every 1-D column (all but P), for operations on all of them: a column added to this list is truncated
+  /// and checked with the others.
+  auto scalar_columns() { return columns_of(*this); }
+  auto scalar_columns() const { return columns_of(*this); }
 
   /// @brief Append one record.
   void push_back(const StepRecord& r);
@@ -65,8 +92,9 @@ struct TimeSeries {
   void truncate(std::size_t n);
   /// @brief True when every column has size() entries.
   [[nodiscard]] bool consistent() const;
-  /// @brief Bitwise equality of all columns.
-  friend bool operator==(const TimeSeries&, const TimeSeries&) = default;
+  /// @brief Bitwise equality of all columns (so a NaN equals the same NaN: columns that were not measured, such as
+  /// the spin of records not taken along a run, compare equal when they were written and read back).
+  friend bool operator==(const TimeSeries& a, const TimeSeries& b);
 };
 
 /// @brief The final tilt of a case (summary final_tilt, degrees): the time mean of axis_tilt (trapezoidal, linear

@@ -8,6 +8,7 @@
 #include <system_error>
 
 #include "solver/diagnostics/material_point.h"
+#include "solver/diagnostics/membrane_spin.h"
 #include "solver/diagnostics/orientation_regime.h"
 #include "solver/diagnostics/time_series.h"
 #include "solver/driver/case_summary.h"
@@ -105,6 +106,7 @@ class CaseRun {
   void restore_or_start() {
     x_ = flow_->reference();
     p_node_ = diagnostics::choose_material_point(mesh(), x_);
+    double spin = 0.0;  // the membrane's spin about its axis (membrane_spin.h) of the state x_: 0 at the start
     if (options_.resume && std::filesystem::exists(checkpoint_file_)) {
       io::Checkpoint cp;
       try {
@@ -119,6 +121,10 @@ class CaseRun {
       step_ = cp.step;
       series_ = cp.series;
       p_node_ = static_cast<int>(cp.scalars["p_node"]);
+      // The spin of the checkpointed state (it accumulates over every step, so the sampled series does not hold
+      // it). A checkpoint from before the spin has none: the spin restarts from 0 at the resumed state (the rows
+      // before read as NaN, so no rate is taken across the restart).
+      if (const auto s = cp.scalars.find("spin"); s != cp.scalars.end()) spin = s->second;
       wrinkle_max_.compressed_area_fraction = cp.scalars["max_compressed_area_fraction"];
       wrinkle_max_.load_roughness = cp.scalars["max_load_roughness"];
       // The most wrinkled sample so far (absent in checkpoints from before the wavelength: none yet).
@@ -153,6 +159,8 @@ class CaseRun {
     keep_central_ = config_.central_symmetry && mesh::is_centrally_symmetric(mesh(), x_, 1e-12);
     before_ = x_;
     record_ = diagnostics::measure_step(mesh(), x_, t_, p_node_, 0.0);
+    record_.spin = spin;
+    before_spin_ = spin;
     first_step_ = step_;
     // Every periodic action sits on a fixed grid of times (multiples of its interval), so a run resumed from
     // a checkpoint checks, samples and saves at exactly the times an uninterrupted run does.
@@ -225,19 +233,21 @@ class CaseRun {
                          " in one step exceeds h_min/2 = " + std::to_string(0.5 * h_min_),
                      x_, step_);
     diagnostics::StepRecord next_record = diagnostics::measure_step(mesh(), next_, t_next, p_node_, 0.0);
+    next_record.spin = diagnostics::advance_spin(record_.spin, mesh(), x_, next_);
     if (std::abs(next_record.volume - V0_) > config_.volume_tolerance * V0_)
       return blow_up("volume changed by " + std::to_string(100.0 * (next_record.volume - V0_) / V0_) + "%", x_,
                      step_);
 
     // x_n passed every test: record it, then accept x_{n+1}.
-    if (snapshot_due) {
-      writer_->write_snapshot(t_, step_, mesh(), x_,
-                              snapshot_fields(mesh(), flow_->mechanics(), x_, start_, config_.membrane_degree));
-      next_snapshot_ += config_.snapshot_interval;
-    }
     record_.tau_min = info.start.tau_min;
     record_.bending_energy = info.start.bending_energy;
     record_.max_bending_moment = info.start.max_bending_moment;
+    if (snapshot_due) {
+      writer_->write_snapshot(t_, step_, mesh(), x_,
+                              snapshot_fields(mesh(), flow_->mechanics(), x_, start_, config_.membrane_degree),
+                              &record_);
+      next_snapshot_ += config_.snapshot_interval;
+    }
     if (t_ >= next_sample_ - eps_) {
       series_.push_back(record_);
       writer_->append(record_);
@@ -245,6 +255,7 @@ class CaseRun {
     }
     std::swap(before_, x_);
     std::swap(x_, next_);
+    before_spin_ = record_.spin;
     record_ = next_record;
     ++step_;
     t_ = t_next;
@@ -256,6 +267,7 @@ class CaseRun {
   bool blow_up(const std::string& failure, const Eigen::Matrix3Xd& good, long good_step) {
     r_.status = "unstable";
     r_.reason = failure + " at t = " + std::to_string(t_);
+    if (&good == &before_) record_.spin = before_spin_;  // the checkpoint carries the spin of the state it holds
     if (&good != &x_) x_ = good;
     step_ = good_step;
     t_ = static_cast<double>(step_) * dt_;
@@ -321,6 +333,11 @@ class CaseRun {
       const bool period = !r_.analysis.periods.empty();
       r_.final_tilt = diagnostics::final_tilt(series_, period ? r_.analysis.periods.front().t_begin : t_,
                                               period ? r_.analysis.periods.front().t_end : t_);
+      // The spin rate over the same window (NaN without a period; solver/README.md §5 says what it is worth for a
+      // window shorter than a revolution of the membrane).
+      if (period)
+        r_.final_spin_rate = diagnostics::final_spin_rate(series_, r_.analysis.periods.front().t_begin,
+                                                          r_.analysis.periods.front().t_end);
       const diagnostics::TiltGrowth growth = diagnostics::tilt_growth_rate(series_, r_.analysis);
       r_.tilt_growth_rate = growth.rate;
       r_.tilt_growth_rate_error = growth.error;
@@ -348,6 +365,7 @@ class CaseRun {
     cp.dt = dt_;
     cp.series = series_;
     cp.scalars["p_node"] = p_node_;
+    cp.scalars["spin"] = record_.spin;
     cp.scalars["max_compressed_area_fraction"] = wrinkle_max_.compressed_area_fraction;
     cp.scalars["max_load_roughness"] = wrinkle_max_.load_roughness;
     cp.scalars["max_wrinkle_amplitude"] = wrinkle_max_.wrinkle_amplitude;
@@ -450,6 +468,7 @@ class CaseRun {
   long first_step_ = 0;
   Eigen::Matrix3Xd before_, next_;  // x_{n-1} (the last good state if x_n runs away) and x_{n+1}
   diagnostics::StepRecord record_;  // diagnostics of x_n, measured when it was accepted
+  double before_spin_ = 0.0;        // the spin of x_{n-1} (before_), should x_n run away
   dynamics::StartFields start_;     // v and q on x_n, kept from the first stage for a snapshot
   double next_check_ = 0, next_checkpoint_ = 0, next_snapshot_ = 0, next_sample_ = 0, next_wrinkle_ = 0;
 

@@ -78,6 +78,10 @@ struct CaseResult {
   /// than two periods (the error: fewer than three).
   double tilt_growth_rate = std::numeric_limits<double>::quiet_NaN();
   double tilt_growth_rate_error = std::numeric_limits<double>::quiet_NaN();
+  /// Mean rate of the membrane's spin about the material axis over the last period found (units of γ̇: radians per
+  /// 1/γ̇; diagnostics::final_spin_rate, membrane_spin.h), positive counter-clockwise about the axis; NaN when no
+  /// period was found.
+  double final_spin_rate = std::numeric_limits<double>::quiet_NaN();
   std::filesystem::path case_file;
 };
 

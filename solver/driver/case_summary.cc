@@ -70,6 +70,7 @@ const NumberField kNumberFields[] = {
     CAPSIM_SUMMARY_NUMBER(final_tilt, final_tilt),
     CAPSIM_SUMMARY_NUMBER(tilt_growth_rate, tilt_growth_rate),
     CAPSIM_SUMMARY_NUMBER(tilt_growth_rate_error, tilt_growth_rate_error),
+    CAPSIM_SUMMARY_NUMBER(final_spin_rate, final_spin_rate),
 };
 #undef CAPSIM_SUMMARY_NUMBER
 
@@ -155,6 +156,7 @@ CaseSummary CaseSummary::of(const config::CaseConfig& config, const CaseResult& 
   s.final_tilt = r.final_tilt;
   s.tilt_growth_rate = r.tilt_growth_rate;
   s.tilt_growth_rate_error = r.tilt_growth_rate_error;
+  s.final_spin_rate = r.final_spin_rate;
   s.threads = omp_get_max_threads();
   s.case_file = r.case_file.empty() ? std::string() : std::filesystem::absolute(r.case_file).string();
   s.code_version = kGitCommit;

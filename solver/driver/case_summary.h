@@ -61,6 +61,7 @@ struct CaseSummary {
   double gmres_iterations_mean = 0, gmres_iterations_max = 0;  ///< viscosity-ratio solve (CaseResult; 0 at λ = 1)
   double final_tilt = 0;  ///< degrees, CaseResult::final_tilt (NaN when read from a result from before it)
   double tilt_growth_rate = 0, tilt_growth_rate_error = 0;  ///< per unit γ̇t, CaseResult (NaN: none, or before them)
+  double final_spin_rate = 0;  ///< units of γ̇, CaseResult::final_spin_rate (NaN: no period, or a result from before it)
   int threads = 0;
   std::string case_file;  ///< absolute path of case.h5
   std::string code_version;    ///< git commit of the build

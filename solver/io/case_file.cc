@@ -17,33 +17,61 @@ namespace {
 constexpr const char* kFormat = "capsim-case";
 constexpr const char* kReserved[] = {"format", "format_version", "code_version", "capsim_version"};
 
-// The 1-D columns of the time series, their units (stored as a `units` attribute) and accessors.
+// The 1-D columns of the time series, their units and descriptions (stored as the `units` and `description`
+// attributes of each dataset) and accessors. solver/README.md §5 documents them at length.
 struct Column {
   const char* name;
   const char* units;
+  const char* description;
   std::vector<double> diagnostics::TimeSeries::*member;
   bool optional = false;  // added later: a file without it reads as `absent`
   double absent = 0.0;    // what an optional column reads as in a file from before it
 };
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr Column kColumns[] = {
-    {"t", "1/shear_rate", &diagnostics::TimeSeries::t},
-    {"D12", "1", &diagnostics::TimeSeries::D12},
-    {"L1", "l", &diagnostics::TimeSeries::L1},
-    {"L2", "l", &diagnostics::TimeSeries::L2},
-    {"theta", "rad", &diagnostics::TimeSeries::theta},
-    {"tau_min", "Gs", &diagnostics::TimeSeries::tau_min},
-    {"volume", "l^3", &diagnostics::TimeSeries::volume},
-    {"area", "l^2", &diagnostics::TimeSeries::area},
-    {"bending_energy", "Gs*l^2", &diagnostics::TimeSeries::bending_energy, true},
-    {"max_bending_moment", "Gs*l", &diagnostics::TimeSeries::max_bending_moment, true},
+    {"t", "1/shear_rate", "time", &diagnostics::TimeSeries::t},
+    {"D12", "1", "Taylor parameter (L1 - L2)/(L1 + L2) of the ellipsoid of inertia in the shear plane",
+     &diagnostics::TimeSeries::D12},
+    {"L1", "l", "longer semi-axis of the ellipsoid of inertia in the shear plane (x1, x2)", &diagnostics::TimeSeries::L1},
+    {"L2", "l", "shorter semi-axis of the ellipsoid of inertia in the shear plane", &diagnostics::TimeSeries::L2},
+    {"theta", "rad", "inclination of L1 to x1, counter-clockwise, in (-pi/2, pi/2]", &diagnostics::TimeSeries::theta},
+    {"tau_min", "Gs", "smallest principal tension over the membrane", &diagnostics::TimeSeries::tau_min},
+    {"volume", "l^3", "enclosed volume", &diagnostics::TimeSeries::volume},
+    {"area", "l^2", "membrane area", &diagnostics::TimeSeries::area},
+    {"bending_energy", "Gs*l^2", "bending energy W_b (0 without bending stiffness)",
+     &diagnostics::TimeSeries::bending_energy, true},
+    {"max_bending_moment", "Gs*l", "largest bending moment kappa_b |c - c0| (0 without bending stiffness)",
+     &diagnostics::TimeSeries::max_bending_moment, true},
     // The material axis (solver/README.md, Orientation). A file from before it holds an in-plane case, whose axis
     // stayed exactly in the plane (the mirror kept bitwise): tilt 0; its direction was not recorded: NaN.
-    {"axis_x1", "1", &diagnostics::TimeSeries::axis_x1, true, kNaN},
-    {"axis_x2", "1", &diagnostics::TimeSeries::axis_x2, true, kNaN},
-    {"axis_x3", "1", &diagnostics::TimeSeries::axis_x3, true, kNaN},
-    {"axis_tilt", "deg", &diagnostics::TimeSeries::axis_tilt, true, 0.0},
-    {"axis_azimuth", "deg", &diagnostics::TimeSeries::axis_azimuth, true, kNaN},
+    {"axis_x1", "1", "material axis (unit, from the node that started at the -x1 pole to the +x1 one), x1 component",
+     &diagnostics::TimeSeries::axis_x1, true, kNaN},
+    {"axis_x2", "1", "material axis, x2 component", &diagnostics::TimeSeries::axis_x2, true, kNaN},
+    {"axis_x3", "1", "material axis, x3 component", &diagnostics::TimeSeries::axis_x3, true, kNaN},
+    {"axis_tilt", "deg", "angle of the material axis out of the shear plane, [0, 90]", &diagnostics::TimeSeries::axis_tilt,
+     true, 0.0},
+    {"axis_azimuth", "deg", "angle of the material axis's projection on the shear plane from x1 toward x2, (-90, 90]",
+     &diagnostics::TimeSeries::axis_azimuth, true, kNaN},
+    // The 3D ellipsoid of inertia and the spin (solver/README.md §5). A file from before them did not record them:
+    // NaN (an in-plane case's La..Lc are not L1, L2, L3 in some order known without the shape).
+    {"La", "l", "largest semi-axis of the 3D ellipsoid of inertia, sqrt(5 mu_a / V)", &diagnostics::TimeSeries::La,
+     true, kNaN},
+    {"Lb", "l", "middle semi-axis of the 3D ellipsoid of inertia", &diagnostics::TimeSeries::Lb, true, kNaN},
+    {"Lc", "l", "smallest semi-axis of the 3D ellipsoid of inertia", &diagnostics::TimeSeries::Lc, true, kNaN},
+    {"ea_x1", "1", "unit direction of La, x1 component (sign: x1 component positive, else x2, else x3)",
+     &diagnostics::TimeSeries::ea_x1, true, kNaN},
+    {"ea_x2", "1", "unit direction of La, x2 component", &diagnostics::TimeSeries::ea_x2, true, kNaN},
+    {"ea_x3", "1", "unit direction of La, x3 component", &diagnostics::TimeSeries::ea_x3, true, kNaN},
+    {"eb_x1", "1", "unit direction of Lb, x1 component", &diagnostics::TimeSeries::eb_x1, true, kNaN},
+    {"eb_x2", "1", "unit direction of Lb, x2 component", &diagnostics::TimeSeries::eb_x2, true, kNaN},
+    {"eb_x3", "1", "unit direction of Lb, x3 component", &diagnostics::TimeSeries::eb_x3, true, kNaN},
+    {"ec_x1", "1", "unit direction of Lc, x1 component", &diagnostics::TimeSeries::ec_x1, true, kNaN},
+    {"ec_x2", "1", "unit direction of Lc, x2 component", &diagnostics::TimeSeries::ec_x2, true, kNaN},
+    {"ec_x3", "1", "unit direction of Lc, x3 component", &diagnostics::TimeSeries::ec_x3, true, kNaN},
+    {"spin", "rad",
+     "membrane rotation about the material axis since the start (the equator node's turn, the axis's own turn "
+     "transported out), counter-clockwise about the axis, unwrapped",
+     &diagnostics::TimeSeries::spin, true, kNaN},
 };
 
 std::string ts(const char* col) { return std::string("timeseries/") + col; }
@@ -116,6 +144,7 @@ struct CaseWriter::Impl {
     h5::create_extendible(f.get(), ts(c.name), 0, options.chunk_rows, file);
     h5::Handle d = h5::checked(H5Dopen2(f.get(), ts(c.name).c_str(), H5P_DEFAULT), H5Dclose, file, "open");
     h5::write_attribute(d.get(), Attribute("units", c.units), file);
+    h5::write_attribute(d.get(), Attribute("description", c.description), file);
   }
 
   void write_pending() {
@@ -195,7 +224,14 @@ CaseWriter CaseWriter::resume(const std::filesystem::path& file, const std::vect
   // Replace the series by the checkpoint's: shrink to 0 and append it again (the series is small).
   impl->options.chunk_rows = std::max<std::size_t>(options.chunk_rows, 1);
   for (const auto& c : kColumns) {
-    if (c.optional && !h5::exists(impl->f.get(), ts(c.name))) impl->create_column(c);  // a file from before it
+    if (c.optional && !h5::exists(impl->f.get(), ts(c.name))) {
+      impl->create_column(c);  // a file from before it
+    } else {
+      // A file from before the descriptions: its columns get theirs (the file then reads as a new one).
+      h5::Handle d = h5::checked(H5Dopen2(impl->f.get(), ts(c.name).c_str(), H5P_DEFAULT), H5Dclose, file, "open");
+      if (!h5::read_attribute(d.get(), "description", file))
+        h5::write_attribute(d.get(), Attribute("description", c.description), file);
+    }
     h5::set_rows(impl->f.get(), ts(c.name), 0, 0, file);
   }
   h5::set_rows(impl->f.get(), ts("P"), 3, 0, file);
@@ -265,7 +301,8 @@ void CaseWriter::set_attribute(const Attribute& attribute) {
 }
 
 void CaseWriter::write_snapshot(double t, std::int64_t step, const mesh::SurfaceMesh& mesh,
-                                const Eigen::Matrix3Xd& x, std::span<const NodeField> fields) {
+                                const Eigen::Matrix3Xd& x, std::span<const NodeField> fields,
+                                const diagnostics::StepRecord* record) {
   auto& im = *impl_;
   if (!im.f.valid()) throw IoError(im.file, "case file already closed");
   const long long n = x.cols();
@@ -302,6 +339,13 @@ void CaseWriter::write_snapshot(double t, std::int64_t step, const mesh::Surface
                                H5Gclose, im.file, "cannot create group " + group);
     h5::write_attribute(g.get(), Attribute("t", t), im.file);
     h5::write_attribute(g.get(), Attribute("step", static_cast<long long>(step)), im.file);
+    if (record) {
+      // The state's row of the time series, column by column (t is the attribute above).
+      diagnostics::TimeSeries row;
+      row.push_back(*record);
+      for (const auto& c : kColumns)
+        if (std::string(c.name) != "t") h5::write_attribute(g.get(), Attribute(c.name, (row.*c.member)[0]), im.file);
+    }
     // Eigen 3×N column-major is exactly N×3 row-major.
     const Eigen::Matrix3Xd xc = x;
     h5::write_dataset(g.get(), "positions", {static_cast<hsize_t>(n), 3}, xc.data(), im.file);
@@ -371,6 +415,8 @@ Snapshot read_snapshot(const std::filesystem::path& file, int index) {
   Snapshot s;
   s.t = h5::require_double(sg.get(), "t", file);
   s.step = h5::require_int(sg.get(), "step", file);
+  for (auto& a : h5::read_attributes(sg.get(), file))
+    if (a.key != "t" && a.key != "step") s.attributes.push_back(std::move(a));
   const auto pd = h5::dataset_dims(sg.get(), "positions", file);
   if (pd.size() != 2 || pd[1] != 3) throw IoError(file, "snapshot positions are not N×3");
   s.positions.resize(3, static_cast<Eigen::Index>(pd[0]));

@@ -7,12 +7,18 @@
 /// Layout (every length in units of ℓ, time in 1/γ̇, tensions in Gs):
 ///   /                      attributes: format = "capsim-case", format_version = 1, code_version (git commit),
 ///                          capsim_version, then the caller's parameters/results (numbers or strings)
-///   /timeseries/{t, D12, L1, L2, theta, tau_min, volume, area}   float64 [n], extendible, chunked
+///   /timeseries/{t, D12, L1, L2, theta, tau_min, volume, area, bending_energy, max_bending_moment,
+///                axis_x1..3, axis_tilt, axis_azimuth, La, Lb, Lc, ea_x1..3, eb_x1..3, ec_x1..3, spin}
+///                          float64 [n], extendible, chunked; attributes `units` and `description` (the table
+///                          kColumns in case_file.cc; solver/README.md §5). Columns added after the first files
+///                          are optional: a file without them reads as 0 or NaN (kColumns says which)
 ///   /timeseries/P          float64 [n, 3]
 ///   /mesh/connectivity_p2  int32 [E, 6] P2 elements (vertices 0,1,2; mid-sides 0–1, 1–2, 2–0), written with
 ///                          the first snapshot; /mesh/connectivity_linear int32 [4E, 3]: each P2 triangle
 ///                          split into 4 flat ones, for tools without quadratic cells
-///   /snapshots/NNNNNN      attributes t, step; positions float64 [N, 3]; one dataset per node field,
+///   /snapshots/NNNNNN      attributes t, step and (when the writer passes the state's record) every other 1-D
+///                          time-series column of that state under its column name (D12, theta, La, ea_x1, spin,
+///                          ...: units as in /timeseries); positions float64 [N, 3]; one dataset per node field,
 ///                          float64 [N] (scalar) or [N, 3] (vector)
 /// The .xmf file (same name, extension .xmf) is a temporal collection over the snapshots with the P2
 /// topology (XDMF Triangle_6, same node order as ours) or the linear split; it is rewritten at each snapshot.
@@ -91,10 +97,11 @@ class CaseWriter {
   /// @brief Write or replace a root attribute (e.g. results: min_D12, regime, status at the end).
   void set_attribute(const Attribute& attribute);
   /// @brief Write a snapshot of the membrane at time t and rewrite the .xmf file. The mesh topology must be
-  /// the same at every snapshot.
+  /// the same at every snapshot. With @p record (the diagnostics of x), its time-series columns but t become
+  /// attributes of the snapshot, so that a snapshot says its shape's ellipsoid, axis and spin without the series.
   /// @throws std::invalid_argument on mismatched sizes or a bad field name.
   void write_snapshot(double t, std::int64_t step, const mesh::SurfaceMesh& mesh, const Eigen::Matrix3Xd& x,
-                      std::span<const NodeField> fields = {});
+                      std::span<const NodeField> fields = {}, const diagnostics::StepRecord* record = nullptr);
   /// @brief Write buffered rows and flush the file to disk.
   void flush();
   /// @brief Flush and close; the writer is unusable afterwards.
@@ -131,6 +138,9 @@ struct Snapshot {
   Eigen::Matrix3Xd positions;
   std::vector<std::array<int, 6>> elements;
   std::vector<NodeField> fields;
+  /// The state's time-series columns written with it (CaseWriter::write_snapshot's record), by name; empty for a
+  /// snapshot written without (a blow-up's last good state, files from before them).
+  std::vector<Attribute> attributes;
 };
 
 /// @brief Read snapshot `index` (0-based, in writing order) of a case file.

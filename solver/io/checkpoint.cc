@@ -40,7 +40,22 @@ constexpr Column kColumns[] = {
     {"axis_x3", &diagnostics::TimeSeries::axis_x3, true, kNaN},
     {"axis_tilt", &diagnostics::TimeSeries::axis_tilt, true, 0.0},
     {"axis_azimuth", &diagnostics::TimeSeries::axis_azimuth, true, kNaN},
+    // The 3D ellipsoid of inertia and the spin; a checkpoint from before them reads them as NaN (as case_file.cc).
+    {"La", &diagnostics::TimeSeries::La, true, kNaN},
+    {"Lb", &diagnostics::TimeSeries::Lb, true, kNaN},
+    {"Lc", &diagnostics::TimeSeries::Lc, true, kNaN},
+    {"ea_x1", &diagnostics::TimeSeries::ea_x1, true, kNaN},
+    {"ea_x2", &diagnostics::TimeSeries::ea_x2, true, kNaN},
+    {"ea_x3", &diagnostics::TimeSeries::ea_x3, true, kNaN},
+    {"eb_x1", &diagnostics::TimeSeries::eb_x1, true, kNaN},
+    {"eb_x2", &diagnostics::TimeSeries::eb_x2, true, kNaN},
+    {"eb_x3", &diagnostics::TimeSeries::eb_x3, true, kNaN},
+    {"ec_x1", &diagnostics::TimeSeries::ec_x1, true, kNaN},
+    {"ec_x2", &diagnostics::TimeSeries::ec_x2, true, kNaN},
+    {"ec_x3", &diagnostics::TimeSeries::ec_x3, true, kNaN},
+    {"spin", &diagnostics::TimeSeries::spin, true, kNaN},
 };
+static_assert(std::size(kColumns) <= 64, "the checksum's `absent` mask has one bit per column");
 
 std::string ts(const char* col) { return std::string("timeseries/") + col; }
 

@@ -11,7 +11,8 @@
 /// read back bitwise identical.
 ///
 /// Layout: root attributes format = "capsim-checkpoint", format_version, code_version, time, step, dt,
-/// num_nodes, num_records, checksum; datasets positions [N, 3], timeseries/{t, D12, …, area} [n],
+/// num_nodes, num_records, checksum; datasets positions [N, 3], timeseries/{t, D12, …, spin} [n] (every 1-D
+/// column of diagnostics::TimeSeries; those added later are optional, read as 0 or NaN from older checkpoints),
 /// timeseries/P [n, 3]; groups scalars and strings whose attributes are the opaque key/value maps.
 
 #include <cstdint>

@@ -198,6 +198,11 @@ SurfaceMesh make_sphere_mesh(int level) {
   for (int i = 0; i < m.num_nodes(); ++i)
     if (m.nodes(1, i) == 0.0 && m.nodes(2, i) == 0.0) m.pole_node[m.nodes(0, i) > 0.0 ? 0 : 1] = i;
   if (m.pole_node[0] < 0 || m.pole_node[1] < 0) throw std::logic_error("mesh: no node on the x1 axis");
+  // The equator node: the normalised mid-point of (±1, φ, 0), bitwise (0, 1, 0) (a single nonzero component
+  // divided by its own norm).
+  for (int i = 0; i < m.num_nodes(); ++i)
+    if (m.nodes(0, i) == 0.0 && m.nodes(2, i) == 0.0 && m.nodes(1, i) > 0.0) m.equator_node = i;
+  if (m.equator_node < 0) throw std::logic_error("mesh: no node on the +x2 axis");
   return m;
 }
 

@@ -56,6 +56,11 @@ struct SurfaceMesh {
   /// (the mid-side nodes of the icosahedron's edges (φ, 0, ±1) and (−φ, 0, ±1), exactly (±1, 0, 0) on the sphere):
   /// the material axis of the orientation diagnostics runs from pole_node[1] to pole_node[0]. −1 if absent.
   std::array<int, 2> pole_node{-1, -1};
+  /// The node on the equator of the revolution axis at +x2 before any rotation (the mid-side node of the
+  /// icosahedron's edge (±1, φ, 0), exactly (0, 1, 0) on the sphere, (≈0, b, 0) on the spheroid): the material
+  /// point whose turn about the material axis is the membrane's spin (diagnostics/membrane_spin.h). A property of
+  /// the mesh, not of a state, so a resumed run has the same one without storing it. −1 if absent.
+  int equator_node = -1;
   /// Subdivision level of the icosahedron (0..6).
   int level = 0;
 

@@ -1,6 +1,7 @@
 // A campaign over the initial orientation (grid axes tilt and azimuth): each case's result echoes its tilt and
 // azimuth (driver::CaseParameters), the store checks them against the case like every parameter, and query cases
-// shows the orientation with what the axis ended doing (final_tilt, regime, tilt_growth_rate).
+// shows the orientation with what the axis ended doing (final_tilt, regime, tilt_growth_rate) and the membrane's
+// spin rate about it (final_spin_rate).
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -37,7 +38,7 @@ TEST(OrientationAxes, TiltedCasesAreStoredWithoutAMismatch) {
     EXPECT_EQ(c["azimuth"].get<double>(), c["summary"]["azimuth"].get<double>()) << c.dump();
     tilted += c["tilt"].get<double>() == 5.0;
     turned += c["azimuth"].get<double>() == 30.0;
-    for (const char* column : {"regime", "final_tilt", "tilt_growth_rate", "tilt_growth_rate_error"})
+    for (const char* column : {"regime", "final_tilt", "tilt_growth_rate", "tilt_growth_rate_error", "final_spin_rate"})
       EXPECT_TRUE(c.contains(column)) << column;
   }
   EXPECT_EQ(tilted, 8);
@@ -45,7 +46,7 @@ TEST(OrientationAxes, TiltedCasesAreStoredWithoutAMismatch) {
   // The tables for reading show the columns too.
   q = sh(exe() + " query cases --db " + db);
   ASSERT_EQ(q.code, 0) << q.err;
-  for (const char* column : {"| tilt", "| azimuth", "| final_tilt", "| regime", "| tilt_growth_rate"})
+  for (const char* column : {"| tilt", "| azimuth", "| final_tilt", "| regime", "| tilt_growth_rate", "| final_spin_rate"})
     EXPECT_NE(q.out.find(column), std::string::npos) << column << "\n" << q.out;
 }
 

@@ -1,8 +1,12 @@
 // Shape moments and ellipsoid of inertia on meshed spheres and spheroids (solver/README.md §5).
 #include "solver/diagnostics/shape_moments.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <utility>
 #include <numbers>
 #include <vector>
 
@@ -146,6 +150,113 @@ TEST(ShapeMoments, RuleDegreeOnlyAffectsSecondMomentsBelowTheGeometricError) {
 TEST(ShapeMoments, RejectsMismatchedPositions) {
   const auto m = mesh::make_sphere_mesh(1);
   EXPECT_THROW(shape_moments(m, Eigen::Matrix3Xd::Zero(3, 5)), std::invalid_argument);
+}
+
+// The expected direction of an axis under the sign rule of EllipsoidOfInertia3D (x1 component positive, else x2,
+// else x3), for a direction whose x1 component is clearly nonzero or exactly zero.
+Eigen::Vector3d oriented(Eigen::Vector3d e) {
+  const double decider = std::abs(e.x()) > 1e-9 ? e.x() : std::abs(e.y()) > 1e-9 ? e.y() : e.z();
+  return decider < 0 ? (-e).eval() : e;
+}
+
+TEST(EllipsoidOfInertia3D, RotatedTriaxialEllipsoidGivesItsSemiAxesAndTheRotationsColumns) {
+  // The a/b = 2 spheroid mesh (semi-axes a, b, b; nodes placed along meridians of x1 by the equal-arc-length map)
+  // squeezed along x3 to c = 0.6 b: every node on the exact ellipsoid (a, b, c), three distinct semi-axes. Then
+  // turned by a rotation about an oblique axis and shifted: the ellipsoid of inertia must give (a, b, c) along
+  // R e1, R e2, R e3.
+  const auto [a, b] = mesh::spheroid_semi_axes(2.0);
+  const double c = 0.6 * b;
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, 2.0, 3.0).normalized()).toRotationMatrix();
+  const Eigen::Vector3d shift(-2.0, 0.5, 1.5);
+  double prev = 1.0;
+  for (int level = 1; level <= 4; ++level) {
+    const auto m = mesh::make_capsule_mesh(level, 2.0);
+    Eigen::Matrix3Xd x = m.nodes;
+    x.row(2) *= 0.6;
+    x = ((R * x).colwise() + shift).eval();
+    const auto el = ellipsoid_of_inertia_3d(shape_moments(m, x));
+    const double err = std::max({std::abs(el.La - a), std::abs(el.Lb - b), std::abs(el.Lc - c)});
+    std::printf("triaxial level %d: La %.8f Lb %.8f Lc %.8f, max|L − exact| = %.2e\n", level, el.La, el.Lb, el.Lc, err);
+    EXPECT_LT(err, prev) << "the semi-axes converge under refinement";
+    prev = err;
+    EXPECT_GE(el.La, el.Lb);
+    EXPECT_GE(el.Lb, el.Lc);
+    // The mesh keeps the sign symmetries of the coordinate axes, so the principal directions are the rotation's
+    // columns at every level, to round-off, each oriented by the sign rule.
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_LT((el.axes[k] - oriented(R.col(k))).norm(), 1e-10) << "level " << level << " axis " << k;
+      EXPECT_NEAR(el.axes[k].norm(), 1.0, 1e-14);
+    }
+  }
+  EXPECT_LT(prev, 1e-4);
+}
+
+TEST(EllipsoidOfInertia3D, InThePlaneItIsTheInPlaneEllipsoidAndX3) {
+  // A shape symmetric under x3 → −x3 has x3 as a principal direction and the other two in the shear plane: the 3D
+  // ellipsoid must be the in-plane one (L1, L2 at θ) plus L3 along x3, whatever order the three semi-axes take.
+  // The seed's spheroids at several inclinations, and a sheared and squeezed one (three distinct semi-axes).
+  Eigen::Matrix3d shear;
+  shear << 1.0, 0.35, 0.0, 0.1, 0.9, 0.0, 0.0, 0.0, 0.8;
+  for (double r : {2.0, 0.5}) {
+    for (double alpha : {0.0, 0.4, -1.2, kPi / 2}) {
+      for (bool sheared : {false, true}) {
+        const auto m = mesh::make_capsule_mesh(3, r);
+        Eigen::Matrix3d A = Eigen::AngleAxisd(alpha, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+        if (sheared) A = (shear * A).eval();
+        const ShapeMoments s = shape_moments(m, A * m.nodes);
+        const EllipsoidOfInertia in_plane = ellipsoid_of_inertia(s);
+        const EllipsoidOfInertia3D el = ellipsoid_of_inertia_3d(s);
+        const std::string what = "a/b " + std::to_string(r) + " alpha " + std::to_string(alpha) +
+                                 (sheared ? " sheared" : "");
+        // The same three semi-axes.
+        std::array<double, 3> expected{in_plane.L1, in_plane.L2, in_plane.L3};
+        std::sort(expected.rbegin(), expected.rend());
+        EXPECT_NEAR(el.La, expected[0], 1e-12) << what;
+        EXPECT_NEAR(el.Lb, expected[1], 1e-12) << what;
+        EXPECT_NEAR(el.Lc, expected[2], 1e-12) << what;
+        // The in-plane axes where the semi-axis is not shared with another (a spheroid's two equal ones have no
+        // defined directions): L1 along (cos θ, sin θ, 0), L2 perpendicular in the plane, L3 along +x3.
+        const Eigen::Vector3d e1(std::cos(in_plane.theta), std::sin(in_plane.theta), 0.0);
+        const Eigen::Vector3d e2(-std::sin(in_plane.theta), std::cos(in_plane.theta), 0.0);
+        const std::array<std::pair<double, Eigen::Vector3d>, 3> in{
+            std::pair{in_plane.L1, e1}, std::pair{in_plane.L2, e2}, std::pair{in_plane.L3, Eigen::Vector3d::UnitZ().eval()}};
+        const std::array<double, 3> L{el.La, el.Lb, el.Lc};
+        for (const auto& [Lk, ek] : in) {
+          int distinct = 0;
+          for (const auto& [Lj, ej] : in) distinct += std::abs(Lj - Lk) > 1e-6;
+          if (distinct != 2) continue;
+          const int k = static_cast<int>(std::min_element(L.begin(), L.end(), [&](double p, double q) {
+                                           return std::abs(p - Lk) < std::abs(q - Lk);
+                                         }) - L.begin());
+          EXPECT_LT((el.axes[k] - oriented(ek)).norm(), 1e-9) << what << " semi-axis " << Lk;
+        }
+      }
+    }
+  }
+}
+
+TEST(EllipsoidOfInertia3D, DirectionsFollowTheSignRuleThroughAHalfTurn) {
+  // A triaxial body turning about x3 (tumbling in the plane): the long axis is (cos θ, sin θ, 0) with θ in
+  // (−π/2, π/2], the same line the in-plane θ names, and the third axis stays +x3 (never flipped by round-off).
+  const auto m = mesh::make_capsule_mesh(2, 2.0);
+  Eigen::Matrix3Xd x0 = m.nodes;
+  x0.row(2) *= 0.7;
+  for (int i = -8; i <= 8; ++i) {
+    const double alpha = i * kPi / 16;
+    const Eigen::Matrix3Xd x = Eigen::AngleAxisd(alpha, Eigen::Vector3d::UnitZ()).toRotationMatrix() * x0;
+    const ShapeMoments s = shape_moments(m, x);
+    const auto el = ellipsoid_of_inertia_3d(s);
+    const auto in_plane = ellipsoid_of_inertia(s);
+    EXPECT_LT((el.axes[0] - Eigen::Vector3d(std::cos(in_plane.theta), std::sin(in_plane.theta), 0.0)).norm(), 1e-12)
+        << "alpha " << alpha;
+    EXPECT_GT(el.axes[0].x(), i == 8 || i == -8 ? -1e-9 : 0.0);
+    EXPECT_EQ(el.axes[2].z() > 0.0, true) << "alpha " << alpha;
+    EXPECT_NEAR(el.axes[2].z(), 1.0, 1e-12);
+  }
+}
+
+TEST(EllipsoidOfInertia3D, RejectsAnEmptyVolume) {
+  EXPECT_THROW(ellipsoid_of_inertia_3d(ShapeMoments{}), std::invalid_argument);
 }
 
 }  // namespace

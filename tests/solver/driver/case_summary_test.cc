@@ -40,6 +40,7 @@ CaseSummary example() {
   s.final_tilt = 12.5;
   s.tilt_growth_rate = -0.02;
   s.tilt_growth_rate_error = 0.003;
+  s.final_spin_rate = -0.46;
   s.parameters.tilt = 3.0;
   s.parameters.azimuth = -30.0;
   return s;
@@ -64,6 +65,7 @@ TEST(CaseSummary, JsonRoundTripKeepsEveryField) {
   EXPECT_EQ(t.final_tilt, 12.5);
   EXPECT_EQ(t.tilt_growth_rate, -0.02);
   EXPECT_EQ(t.tilt_growth_rate_error, 0.003);
+  EXPECT_EQ(t.final_spin_rate, -0.46);
   EXPECT_EQ(t.parameters.tilt, 3.0);
   EXPECT_EQ(t.parameters.azimuth, -30.0);
 }
@@ -113,7 +115,7 @@ TEST(CaseSummary, JsonHasTheContractKeys) {
                           "wrinkle_wavelength_of_max", "steps", "flow_evaluations", "dt", "t_final",
                           "wall_s", "threads",
                           "case_file", "code_version", "kernel_isa", "solver_version", "tilt", "azimuth",
-                          "final_tilt", "tilt_growth_rate", "tilt_growth_rate_error"})
+                          "final_tilt", "tilt_growth_rate", "tilt_growth_rate_error", "final_spin_rate"})
     EXPECT_TRUE(j.contains(key)) << key;
 }
 

@@ -202,6 +202,8 @@ TEST(CaseFile, FileFromBeforeTheBendingColumnsReadsAndResumes) {
   for (std::size_t i = 0; i < c.series.size(); ++i) {
     EXPECT_EQ(c.series.bending_energy[i], 0.0);
     EXPECT_EQ(c.series.max_bending_moment[i], 0.0);
+    // Nor the 3D ellipsoid and the spin (added later still): not recorded, NaN.
+    EXPECT_TRUE(std::isnan(c.series.La[i]) && std::isnan(c.series.ec_x3[i]) && std::isnan(c.series.spin[i]));
   }
   {
     CaseWriter w = CaseWriter::resume(file, {}, c.series);
@@ -212,6 +214,71 @@ TEST(CaseFile, FileFromBeforeTheBendingColumnsReadsAndResumes) {
   ASSERT_EQ(r.series.size(), c.series.size() + 1);
   EXPECT_EQ(r.series.max_bending_moment.back(), record(7).max_bending_moment);
   EXPECT_EQ(r.series.D12[0], c.series.D12[0]);
+  EXPECT_EQ(r.series.La.back(), record(7).La);
+  EXPECT_TRUE(std::isnan(r.series.spin.back())) << "record(7) has no spin measured";
+  // Its old columns got their descriptions, the new ones were created with theirs.
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  for (const char* name : {"D12", "axis_tilt", "spin"}) {
+    const hid_t d = H5Dopen2(f, (std::string("timeseries/") + name).c_str(), H5P_DEFAULT);
+    EXPECT_GT(H5Aexists(d, "description"), 0) << name;
+    H5Dclose(d);
+  }
+  H5Fclose(f);
+}
+
+// The columns say what they are: units and a description on every dataset of the time series.
+TEST(CaseFile, EveryColumnHasUnitsAndADescription) {
+  const auto file = scratch("described.h5");
+  {
+    CaseWriter w(file, {});
+    w.append(record(0));
+  }
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  int columns = 0;
+  for (const char* name : {"t", "D12", "theta", "axis_tilt", "La", "Lb", "Lc", "ea_x1", "eb_x2", "ec_x3", "spin"}) {
+    const hid_t d = H5Dopen2(f, (std::string("timeseries/") + name).c_str(), H5P_DEFAULT);
+    ASSERT_GE(d, 0) << name;
+    EXPECT_GT(H5Aexists(d, "units"), 0) << name;
+    EXPECT_GT(H5Aexists(d, "description"), 0) << name;
+    H5Dclose(d);
+    ++columns;
+  }
+  H5Fclose(f);
+  EXPECT_EQ(columns, 11);
+}
+
+// A snapshot written with its state's record holds the record's columns as attributes (t and step as before); one
+// written without holds none.
+TEST(CaseFile, SnapshotAttributesHoldTheStatesRecord) {
+  const auto file = scratch("snapshot_record.h5");
+  const auto mesh = mesh::make_capsule_mesh(1, 2.0);
+  diagnostics::StepRecord rec = record(3);
+  rec.La = 1.6;
+  rec.Lb = 0.8;
+  rec.Lc = 0.7;
+  rec.ea = {0.6, 0.8, 0.0};
+  rec.spin = -2.25;
+  {
+    CaseWriter w(file, {});
+    w.write_snapshot(rec.t, 3, mesh, mesh.nodes, {}, &rec);
+    w.write_snapshot(0.5, 50, mesh, mesh.nodes);
+  }
+  const Snapshot s = read_snapshot(file, 0);
+  EXPECT_EQ(s.t, rec.t);
+  EXPECT_EQ(s.step, 3);
+  auto value = [&](const std::string& key) {
+    const Attribute* a = find(s.attributes, key);
+    return a ? std::get<double>(a->value) : std::nan("");
+  };
+  EXPECT_EQ(value("La"), 1.6);
+  EXPECT_EQ(value("Lc"), 0.7);
+  EXPECT_EQ(value("ea_x2"), 0.8);
+  EXPECT_EQ(value("spin"), -2.25);
+  EXPECT_EQ(value("D12"), rec.D12);
+  EXPECT_EQ(find(s.attributes, "t"), nullptr) << "t is the snapshot's own attribute, read into Snapshot::t";
+  EXPECT_TRUE(read_snapshot(file, 1).attributes.empty());
 }
 
 }  // namespace

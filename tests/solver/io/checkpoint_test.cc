@@ -223,12 +223,45 @@ TEST(Checkpoint, CheckpointFromBeforeTheBendingColumnsReads) {
     EXPECT_EQ(c.series.axis_tilt[i], 0.0);
     EXPECT_TRUE(std::isnan(c.series.axis_azimuth[i]));
     EXPECT_TRUE(std::isnan(c.series.axis_x1[i]));
+    EXPECT_TRUE(std::isnan(c.series.La[i]) && std::isnan(c.series.spin[i]));  // nor the 3D ellipsoid and spin
   }
   EXPECT_EQ(c.step, 5);
   // Written again by this code, it has the columns and reads back bitwise.
   const auto file = scratch("pre_bending_rewritten.h5");
   write_checkpoint(file, c);
   EXPECT_TRUE(bitwise_equal(c, read_checkpoint(file)));
+}
+
+// A checkpoint of the build before the 3D ellipsoid and the spin (committed fixture, code of 9bf4090, a tilted case:
+// see tests/solver/driver/orientation_diagnostics_test.cc, which resumes it) reads — checksum verified without the
+// new columns only, the axis columns present — with the new columns NaN and no spin among its scalars.
+TEST(Checkpoint, CheckpointFromBeforeTheSpinReads) {
+  const auto src = std::filesystem::path(CAPSIM_SOURCE_DIR) / "tests/solver/io/data/pre_spin_checkpoint.h5";
+  const Checkpoint c = read_checkpoint(src);
+  ASSERT_EQ(c.series.size(), 5u);
+  EXPECT_TRUE(c.series.consistent());
+  for (std::size_t i = 0; i < c.series.size(); ++i) {
+    EXPECT_NEAR(c.series.axis_tilt[i], 30.0, 1.0) << "the axis columns were there";
+    EXPECT_TRUE(std::isfinite(c.series.axis_x1[i]));
+    EXPECT_TRUE(std::isnan(c.series.La[i]) && std::isnan(c.series.eb_x2[i]) && std::isnan(c.series.spin[i]));
+  }
+  EXPECT_EQ(c.scalars.count("spin"), 0u);
+  EXPECT_EQ(c.scalars.count("p_node"), 1u);
+  const auto file = scratch("pre_spin_rewritten.h5");
+  write_checkpoint(file, c);
+  EXPECT_TRUE(bitwise_equal(c, read_checkpoint(file)));
+  // A flipped byte in the positions is still caught by the checksum taken without the new columns.
+  hid_t f = H5Fopen(src.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  hid_t d = H5Dopen2(f, "positions", H5P_DEFAULT);
+  const haddr_t offset = H5Dget_offset(d);
+  H5Dclose(d);
+  H5Fclose(f);
+  ASSERT_NE(offset, HADDR_UNDEF);
+  auto bytes = read_bytes(src);
+  bytes[offset + 100] ^= 0x10;
+  const auto damaged = scratch("pre_spin_damaged.h5");
+  write_bytes(damaged, bytes, bytes.size());
+  expect_io_error_naming(damaged, "checksum");
 }
 
 }  // namespace

@@ -254,6 +254,31 @@ TEST(CapsuleMesh, PoleNodesSitOnTheRevolutionAxis) {
     }
 }
 
+// The equator node (the spin's material point): on the revolution axis's equator at +x2, on every level and shape,
+// and carried by the orientation's rotation to R e2 (in the shear plane: the rotation keeps e2 there).
+TEST(CapsuleMesh, EquatorNodeSitsOnTheEquatorAtPlusX2) {
+  for (int level = 0; level <= 3; ++level)
+    for (const double r : {0.5, 1.0, 2.0}) {
+      const SurfaceMesh m = make_capsule_mesh(level, r);
+      const double b = spheroid_semi_axes(r)[1];
+      ASSERT_GE(m.equator_node, 0);
+      EXPECT_NE(m.equator_node, m.pole_node[0]);
+      // x1 = a cos θ′ with θ′ the spheroid map's image of π/2, found by bisection: 0 to round-off.
+      EXPECT_NEAR(m.nodes(0, m.equator_node), 0.0, 1e-14) << "level " << level << " r " << r;
+      EXPECT_EQ(m.nodes(2, m.equator_node), 0.0);
+      EXPECT_NEAR(m.nodes(1, m.equator_node), b, 1e-15);
+      if (r == 1.0) {
+        EXPECT_EQ(m.nodes(1, m.equator_node), 1.0) << "exactly (0, 1, 0) on the sphere";
+      }
+    }
+  SurfaceMesh m = make_capsule_mesh(2, 2.0);
+  const int e = m.equator_node;
+  orient_capsule_mesh(m, 30.0, 40.0);
+  EXPECT_EQ(m.equator_node, e);
+  const Eigen::Vector3d expected = spheroid_semi_axes(2.0)[1] * orientation_rotation(30.0, 40.0).col(1);
+  EXPECT_LT((m.nodes.col(e) - expected).norm(), 1e-14);
+}
+
 // tilt = azimuth = 0 leaves the mesh bitwise alone (every in-plane case keeps its results bit for bit).
 TEST(CapsuleMesh, ZeroOrientationIsBitwiseTheUnrotatedMesh) {
   const SurfaceMesh ref = make_capsule_mesh(2, 2.0);

@@ -612,14 +612,15 @@ std::vector<CaseSample> Store::campaign_samples(std::int64_t campaign_id) {
   Stmt s(*db_,
          "SELECT c.case_id, c.params_json, c.status, r.min_D12, r.max_tau_min, "
          "json_extract(r.raw_json, '$.min_D12_period_spread'), json_extract(r.raw_json, '$.max_tau_min_period_spread'), "
-         "r.dt FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id LEFT JOIN results r ON r.case_id=c.case_id "
+         "r.dt, coalesce(r.regime,'') FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id "
+         "LEFT JOIN results r ON r.case_id=c.case_id "
          "WHERE cc.campaign_id=? ORDER BY c.law, c.aspect_ratio, coalesce(c.skalak_C,-1), c.mesh_level, "
          "c.capillary_number");
   s.bind(1, campaign_id);
   std::vector<CaseSample> out;
   while (s.step())
     out.push_back({s.text(0), CaseParams::from_json(s.text(1)), s.text(2), s.real(3), s.real(4), s.real(5), s.real(6),
-                   s.real(7)});
+                   s.real(7), s.text(8)});
   return out;
 }
 

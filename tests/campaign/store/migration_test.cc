@@ -109,7 +109,9 @@ TEST(Migration, AnalysedVersion2DatabaseGainsTheRegimeTransition) {
       EXPECT_EQ(row.at("ca_ts_high"), 0.35);
       EXPECT_EQ(row.at("ca_ts_note"), "skipped unknown at Ca=2");
     }
-    if (row.at("aspect_ratio") == 1.0) EXPECT_TRUE(row.at("ca_ts_low").is_null() && row.at("ca_ts_note").is_null());
+    if (row.at("aspect_ratio") == 1.0) {
+      EXPECT_TRUE(row.at("ca_ts_low").is_null() && row.at("ca_ts_note").is_null()) << row;
+    }
   }
   r = sh(exe() + " query transitions --db " + db + " --format csv");
   ASSERT_EQ(r.code, 0) << r.err;

@@ -13,6 +13,70 @@
 
 namespace capsim::campaign {
 
+namespace {
+
+// "a" or "a to b": a range of sampled Ca as the notes print it.
+std::string sampled_range(double a, double b) {
+  return same_ca(a, b) ? format_sampled(a) : format_sampled(a) + " to " + format_sampled(b);
+}
+
+// Ca_TS of @p samples (sorted by Ca) into t.ca_ts_low, t.ca_ts_high and t.ca_ts_note (analyse_group's contract).
+void regime_transition(const std::vector<Sample>& samples, Transition& t) {
+  if (is_sphere(t)) return;  // a sphere does not tumble: no transition to read
+  if (samples.empty()) {
+    t.ca_ts_note = "no finished case";
+    return;
+  }
+  const std::string_view tumbling = diagnostics::to_string(diagnostics::Regime::tumbling);
+  const std::string_view swinging = diagnostics::to_string(diagnostics::Regime::swinging);
+  std::vector<const Sample*> in_plane;  // tumbling or swinging, in Ca order
+  std::vector<std::pair<std::string, std::string>> skipped;  // regime -> its Ca, in order of first appearance
+  for (const auto& s : samples) {
+    if (s.regime == tumbling || s.regime == swinging) {
+      in_plane.push_back(&s);
+      continue;
+    }
+    const std::string name = s.regime.empty() ? "no recorded regime" : s.regime;
+    auto it = std::find_if(skipped.begin(), skipped.end(), [&](const auto& x) { return x.first == name; });
+    if (it == skipped.end()) skipped.emplace_back(name, "Ca=" + format_sampled(s.ca));
+    else it->second += ", " + format_sampled(s.ca);
+  }
+  std::vector<std::string> notes;
+  const auto n = static_cast<int>(in_plane.size());
+  int first_swinging = n, last_tumbling = -1;
+  for (int i = 0; i < n; ++i) {
+    if (in_plane[i]->regime == swinging && first_swinging == n) first_swinging = i;
+    if (in_plane[i]->regime == tumbling) last_tumbling = i;
+  }
+  if (n == 0) {
+    notes.push_back("no tumbling or swinging case");
+  } else if (first_swinging == n) {
+    notes.push_back("tumbles at every sampled Ca (" + sampled_range(in_plane.front()->ca, in_plane.back()->ca) + ")");
+  } else if (last_tumbling < 0) {
+    notes.push_back("swings from the smallest sampled Ca (" + format_sampled(in_plane.front()->ca) + ")");
+  } else if (last_tumbling < first_swinging) {  // monotone: last_tumbling == first_swinging - 1
+    t.ca_ts_low = in_plane[last_tumbling]->ca;
+    t.ca_ts_high = in_plane[first_swinging]->ca;
+  } else {
+    std::string what = std::string(kRegimesNotMonotone) + ": tumbling at Ca=" +
+                       format_sampled(in_plane[last_tumbling]->ca) + " above swinging at Ca=" +
+                       format_sampled(in_plane[first_swinging]->ca);
+    if (first_swinging > 0 && last_tumbling + 1 < n) {
+      t.ca_ts_low = in_plane[first_swinging - 1]->ca;
+      t.ca_ts_high = in_plane[last_tumbling + 1]->ca;
+      what += "; the bracket is the outermost: every sample below it tumbles, every one above it swings";
+    } else {
+      what += first_swinging == 0 ? "; swinging at the smallest sampled Ca" : "; tumbling at the largest sampled Ca";
+      what += ", so no bracket has tumbling below and swinging above";
+    }
+    notes.push_back(what);
+  }
+  for (const auto& [regime, cas] : skipped) notes.push_back("skipped " + regime + " at " + cas);
+  for (const auto& x : notes) t.ca_ts_note += (t.ca_ts_note.empty() ? "" : "; ") + x;
+}
+
+}  // namespace
+
 Transition analyse_group(Transition t, std::vector<Sample> samples, double thr) {
   std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.ca < b.ca; });
   t.d12_threshold = thr;
@@ -21,6 +85,8 @@ Transition analyse_group(Transition t, std::vector<Sample> samples, double thr) 
   t.ca_h = t.ca_h_low = t.ca_h_high = std::nullopt;
   t.ca_h_low_case.clear();
   t.ca_h_high_case.clear();
+  t.ca_ts_low = t.ca_ts_high = std::nullopt;
+  t.ca_ts_note.clear();
   std::vector<std::string> notes;
 
   // Ca*: the sampled Ca with min D12 < threshold (not for a sphere: is_sphere says why).
@@ -95,6 +161,8 @@ Transition analyse_group(Transition t, std::vector<Sample> samples, double thr) 
       t.ca_h = ya == yb ? a.ca : a.ca + (b.ca - a.ca) * ya / (ya - yb);
     }
   }
+  // Ca_TS: its own note (ca_ts_note), so that `note` stays what the Ca* and CaH analysis says.
+  regime_transition(samples, t);
   if (samples.empty()) notes.push_back("no finished case");
   t.note.clear();
   for (const auto& n : notes) t.note += (t.note.empty() ? "" : "; ") + n;
@@ -132,7 +200,8 @@ std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases) {
       return t ? *t : std::string(unset);
     };
     const std::string stop_test = text("time.stop_test", diagnostics::kStopTestBoth);
-    const Sample sample{ca, c.min_d12, c.max_tau_min, c.case_id, c.min_d12_spread, c.max_tau_min_spread, c.dt, stop_test};
+    const Sample sample{ca, c.min_d12, c.max_tau_min, c.case_id, c.min_d12_spread, c.max_tau_min_spread,
+                        c.dt, stop_test, c.regime};
     // One sample per Ca: where a Ca was run in both precisions, the double one (the reference); then the one
     // whose stop waited for both answers.
     const int rank =

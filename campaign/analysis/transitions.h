@@ -1,14 +1,16 @@
 #pragma once
 /// @file
 /// @brief Critical capillary numbers from finished cases: the Ca* interval (sampled Ca with
-/// min D12 < threshold, the seed's Table 1 criterion) and CaH (zero of max tau_min, interpolated linearly
-/// between the bracketing samples), computed per group of cases that agree in every identity key but Ca.
+/// min D12 < threshold, the seed's Table 1 criterion), CaH (zero of max tau_min, interpolated linearly
+/// between the bracketing samples) and the tumbling-to-swinging bracket Ca_TS read from the cases' regimes,
+/// computed per group of cases that agree in every identity key but Ca.
 /// Pure computation on values: the store reads the cases (CaseSample) and saves the rows (Transition); this
 /// folder never touches the database, so the store may use these types without a cycle (store -> analysis).
 
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "campaign/grid/case_params.h"
@@ -52,7 +54,19 @@ struct Transition {
   /// @brief Each answer ("ca_star_low", "ca_star_high", "ca_h") on the other levels its mesh error compared
   /// (level -> value in Ca; AnswerError::on_level): e.g. the check level's value of an error check.
   std::map<std::string, std::map<int, double>> level_answers;
+  /// @brief The tumbling-to-swinging transition read from the regime each case reports (Ca_TS; analyse_group
+  /// gives the definition): the adjacent tumbling and swinging samples it lies between. Both set or neither
+  /// (schema 7). Its error is the bracket itself: the two ends are sampled values, nothing is interpolated.
+  std::optional<double> ca_ts_low, ca_ts_high;
+  /// @brief Why Ca_TS has no bracket ("tumbles at every sampled Ca (0.02 to 5)"), that its bracket is not a
+  /// clean one (starts with kRegimesNotMonotone) and which samples it skipped; "" for a sphere, and for a clean
+  /// bracket with nothing skipped.
+  std::string ca_ts_note;
 };
+
+/// @brief How Transition::ca_ts_note begins when the sampled regimes are not monotone in Ca (a tumbling sample
+/// above a swinging one): the reader of a bracket must know that samples inside it disagree.
+inline constexpr std::string_view kRegimesNotMonotone = "regimes not monotone in Ca";
 
 /// @brief True for an initially spherical capsule (a/b = 1). It does not tumble, so the seed's Ca* (the
 /// band of a tumbling-to-swinging transition) does not apply to it: its min D12 falls below any threshold as
@@ -76,6 +90,9 @@ struct Sample {
   std::optional<double> max_tau_min_spread;  ///< max_tau_min_period_spread of its result
   std::optional<double> dt;                  ///< time step the case ran with
   std::string stop_test{diagnostics::kStopTestBoth};  ///< its time.stop_test (which answers its stop waited for)
+  /// @brief The regime its result reports (results.regime, spelled as diagnostics::to_string: "tumbling",
+  /// "swinging", "steady", "unknown", "kayaking", ...); "" when not recorded.
+  std::string regime;
 };
 
 /// @brief One case of a campaign with its result, as the store reads it (the input of the grouping).
@@ -86,6 +103,7 @@ struct CaseSample {
   std::optional<double> min_d12;        ///< from its result (done/unstable), else nullopt
   std::optional<double> max_tau_min;    ///< from its result, else nullopt
   std::optional<double> min_d12_spread, max_tau_min_spread, dt;  ///< from its result (Sample says what)
+  std::string regime;                   ///< from its result (Sample::regime), else ""
 };
 
 /// @brief The cases of one group.
@@ -107,6 +125,22 @@ std::vector<SampleGroup> group_cases(const std::vector<CaseSample>& cases);
 /// CaH with max tau_min < 0 at every sample: for a spheroid, ca_h_high bounds it (CaH below the smallest
 /// sample); for a sphere nothing does (it is compressed below a CaL as well), so both bounds stay empty and
 /// the note says why.
+///
+/// Ca_TS (ca_ts_low, ca_ts_high, ca_ts_note), the tumbling-to-swinging transition by the cases' own regimes:
+/// of the samples in Ca order, only those whose regime is "tumbling" or "swinging" count; the others (steady,
+/// unknown, the off-plane kayaking, rolling, ...) name neither side of an in-plane transition and are skipped,
+/// the note listing them. Then
+/// - tumbling below and swinging above one pair of adjacent samples: that pair is the bracket;
+/// - every sample tumbles: no bracket, note "tumbles at every sampled Ca (a to b)"; every sample swings: no
+///   bracket, note "swings from the smallest sampled Ca (a)"; none of either: note "no tumbling or swinging case";
+/// - not monotone (a tumbling sample above a swinging one): when the smallest sample tumbles and the largest
+///   swings, the outermost bracket, from the last tumbling sample below the first swinging one to the first
+///   swinging sample above the last tumbling one: every sample below it tumbles and every one above it swings,
+///   so it holds every change of regime sampled (a misnamed or bistable sample near the transition widens the
+///   bracket instead of hiding it); otherwise (swinging at the smallest sample, or tumbling at the largest) no
+///   bracket. Either way the note begins with kRegimesNotMonotone and names the first swinging and the last
+///   tumbling sample.
+/// A sphere (is_sphere) gets nothing: it does not tumble.
 Transition analyse_group(Transition key, std::vector<Sample> samples, double d12_threshold);
 
 /// @brief analyse_group of every group, with @p method recorded.

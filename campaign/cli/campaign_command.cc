@@ -67,7 +67,8 @@ std::string key_values(const std::string& group_key, const std::vector<std::stri
   return out;
 }
 
-// The transitions as `status` prints them: sampled Ca as sampled, CaH to the leading digit of its bracket
+// The transitions as `status` prints them (with the regime bracket Ca_TS; its note is in `query transitions`):
+// sampled Ca as sampled, CaH to the leading digit of its bracket
 // width (its error bound), no digit more (`capsim query sql` gives the stored values in full). A column
 // "group" names the other keys that tell the rows apart, where there are such.
 campaign::Table transitions_table(const std::vector<campaign::Transition>& rows) {
@@ -76,7 +77,7 @@ campaign::Table transitions_table(const std::vector<campaign::Transition>& rows)
   for (const auto& r : rows) groups.push_back(r.group_key);
   const auto keys = varying_keys(groups);
   t.columns = {"law", "aspect_ratio", "skalak_C", "mesh_level", "role", "n_samples", "ca_star_low", "ca_star_high",
-               "ca_h", "ca_h_low", "ca_h_high", "method", "note"};
+               "ca_h", "ca_h_low", "ca_h_high", "ca_ts_low", "ca_ts_high", "method", "note"};
   if (!keys.empty()) t.columns.insert(t.columns.begin() + 4, "group");
   auto sampled = [](const std::optional<double>& x) {
     return x ? campaign::SqlValue{campaign::format_sampled(*x)} : campaign::SqlValue{nullptr};
@@ -90,7 +91,8 @@ campaign::Table transitions_table(const std::vector<campaign::Transition>& rows)
     t.rows.push_back({r.law, campaign::format_sampled(r.aspect_ratio),
                       r.skalak_C < 0 ? campaign::SqlValue{nullptr} : campaign::SqlValue{campaign::format_sampled(r.skalak_C)},
                       std::int64_t{r.mesh_level}, r.role, std::int64_t{r.n_samples}, sampled(r.ca_star_low),
-                      sampled(r.ca_star_high), h, sampled(r.ca_h_low), sampled(r.ca_h_high), r.method, r.note});
+                      sampled(r.ca_star_high), h, sampled(r.ca_h_low), sampled(r.ca_h_high), sampled(r.ca_ts_low),
+                      sampled(r.ca_ts_high), r.method, r.note});
     if (!keys.empty()) t.rows.back().insert(t.rows.back().begin() + 4, key_values(r.group_key, keys));
   }
   return t;

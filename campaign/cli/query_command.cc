@@ -81,7 +81,9 @@ campaign::Table transitions_table(const std::vector<campaign::Transition>& rows,
                "ca_star_low_err_lacks", "ca_star_high_err_lacks", "ca_h_err_lacks",
                // added for the scripts that render Table 1 (scripts/table1, scripts/plot):
                "campaign", "skalak_C", "role", "n_samples", "ca_star_below", "ca_star_above", "ca_min_d12", "ca_h_low",
-               "ca_h_high", "method", "note", "error_note", "group_key"};
+               "ca_h_high", "method", "note", "error_note", "group_key",
+               // the regime-based tumbling-to-swinging bracket (analysis/transitions.h, schema 7):
+               "ca_ts_low", "ca_ts_high", "ca_ts_note"};
   t.json_columns = {"level_answers", "group_key"};  // {"ca_h": {"2": 0.23, "4": 0.61}, ...}: nested in JSON output
   auto text_or_null = [](const std::string& x) { return x.empty() ? SqlValue{nullptr} : SqlValue{x}; };
   for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -96,9 +98,24 @@ campaign::Table transitions_table(const std::vector<campaign::Transition>& rows,
                       r.skalak_C < 0 ? SqlValue{nullptr} : SqlValue{r.skalak_C}, r.role, std::int64_t{r.n_samples},
                       value_of(r.ca_star_below), value_of(r.ca_star_above), value_of(r.ca_min_d12),
                       value_of(r.ca_h_low), value_of(r.ca_h_high), r.method, text_or_null(r.note),
-                      text_or_null(r.error_note), text_or_null(r.group_key)});
+                      text_or_null(r.error_note), text_or_null(r.group_key), value_of(r.ca_ts_low),
+                      value_of(r.ca_ts_high), text_or_null(r.ca_ts_note)});
   }
   return t;
+}
+
+// Table 1's Ca_TS line of one cell: the bracket as sampled, "(regime)" naming where it comes from; without one,
+// why (the note: "tumbles at every sampled Ca (0.02 to 5)"); nothing for a sphere, which does not tumble. A row
+// analysed before schema 7 has neither bracket nor note.
+std::string regime_transition_text(const campaign::Transition& r) {
+  if (campaign::is_sphere(r)) return "";
+  if (r.ca_ts_low && r.ca_ts_high) {
+    const bool monotone = r.ca_ts_note.rfind(campaign::kRegimesNotMonotone, 0) != 0;
+    return "Ca_TS ∈ (" + campaign::format_sampled(*r.ca_ts_low) + ", " + campaign::format_sampled(*r.ca_ts_high) +
+           ") (regime" + (monotone ? "" : ", not monotone") + ")";
+  }
+  if (!r.ca_ts_note.empty()) return r.ca_ts_note;
+  return "Ca_TS not analysed (capsim campaign analyse)";
 }
 
 // `only[i]`: the value of kPhysicalAxes[i] asked for (nullopt: any, but one per cell).
@@ -154,7 +171,9 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
     std::printf("%s", campaign::render(transitions_table(rows, std::vector<std::string>(rows.size(), camp)), fmt).c_str());
     return 0;
   }
-  // Markdown laid out like the seed's Table 1: one column per a/b, a Ca* line and a CaH line per law. With an
+  // Markdown laid out like the seed's Table 1: one column per a/b, a Ca* line and a CaH line per law, and a third
+  // line with the regime-based bracket Ca_TS (not the seed's: where the Ca* criterion misfires, e.g. a viscous
+  // interior, it is the transition). With an
   // error estimate (analysis/uncertainty.h) an answer prints "x ± e", x to the digit of e. Without one, the
   // Ca* edges are sampled values (printed as sampled) and CaH, interpolated in its bracket, is rounded to the
   // leading digit of the bracket width (a lower bound of its error: the mesh error is not known). An error
@@ -175,7 +194,7 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
   for (std::size_t i = 0; i < ars.size(); ++i) out += "---|";
   out += "\n";
   for (const auto& [law, C] : laws) {
-    std::string star = "| " + law_label(law, C) + " |", h = "| |";
+    std::string star = "| " + law_label(law, C) + " |", h = "| |", ts = "| |";
     for (double a : ars) {
       const campaign::Transition* r = nullptr;
       for (const auto& x : rows)
@@ -183,6 +202,7 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
       if (!r) {
         star += " |";
         h += " |";
+        ts += " |";
         continue;
       }
       // An answer with an error estimate prints "x ± e" (digits of the error), "x ± e†" when e lacks a part;
@@ -207,8 +227,9 @@ int table1(campaign::Store& store, const std::string& name, campaign::Format fmt
                ? " CaH = " + (r->ca_h_err ? with_error(*r->ca_h, *r->ca_h_err, r->ca_h_err_lacks)
                                           : campaign::format_with_error(*r->ca_h, *r->ca_h_high - *r->ca_h_low)) + " |"
                : " CaH not bracketed |";
+      ts += " " + regime_transition_text(*r) + " |";
     }
-    out += star + "\n" + h + "\n";
+    out += star + "\n" + h + "\n" + ts + "\n";
   }
   if (!lacking.empty()) {
     // The union of the missing parts in the order of kErrorParts, each with why it has no data.
@@ -296,7 +317,8 @@ int query_command(const std::vector<std::string>& args) {
     sub->add_option("--db", db, "SQLite results database")->required();
     sub->add_option("--format", format, "md (default), csv or json");
   };
-  auto* t1 = app.add_subcommand("table1", "Ca* interval and CaH per law and a/b, laid out like the seed's Table 1");
+  auto* t1 = app.add_subcommand("table1", "Ca* interval, CaH and the regime bracket Ca_TS per law and a/b, laid out "
+                                          "like the seed's Table 1");
   common(t1);
   t1->add_option("--campaign", camp, "campaign name (default: the most recently run)");
   int mesh_level = -1;

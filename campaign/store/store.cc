@@ -586,8 +586,8 @@ void Store::save_transitions(std::int64_t campaign_id, const std::vector<Transit
                            "ca_h,ca_h_low,ca_h_high,ca_h_low_case,ca_h_high_case,method,note,role,ca_star_low_err,"
                            "ca_star_high_err,ca_h_err,ca_star_low_err_source,ca_star_high_err_source,ca_h_err_source,"
                            "error_levels,error_note,level_answers,ca_star_low_err_lacks,ca_star_high_err_lacks,"
-                           "ca_h_err_lacks,updated_at) "
-                           "VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,") + kNow + ")");
+                           "ca_h_err_lacks,ca_ts_low,ca_ts_high,ca_ts_note,updated_at) "
+                           "VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,") + kNow + ")");
   auto opt_text = [](const std::string& x) { return x.empty() ? SqlValue{nullptr} : SqlValue{x}; };
   for (const auto& r : rows) {
     s.reset();
@@ -603,6 +603,7 @@ void Store::save_transitions(std::int64_t campaign_id, const std::vector<Transit
     s.bind(30, opt_text(level_answers_json(r.level_answers)));
     s.bind(31, opt_text(r.ca_star_low_err_lacks)).bind(32, opt_text(r.ca_star_high_err_lacks));
     s.bind(33, opt_text(r.ca_h_err_lacks));
+    s.bind_opt(34, r.ca_ts_low).bind_opt(35, r.ca_ts_high).bind(36, opt_text(r.ca_ts_note));
     s.step();
   }
   t.commit();
@@ -612,14 +613,15 @@ std::vector<CaseSample> Store::campaign_samples(std::int64_t campaign_id) {
   Stmt s(*db_,
          "SELECT c.case_id, c.params_json, c.status, r.min_D12, r.max_tau_min, "
          "json_extract(r.raw_json, '$.min_D12_period_spread'), json_extract(r.raw_json, '$.max_tau_min_period_spread'), "
-         "r.dt FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id LEFT JOIN results r ON r.case_id=c.case_id "
+         "r.dt, coalesce(r.regime,'') FROM cases c JOIN campaign_cases cc ON cc.case_id=c.case_id "
+         "LEFT JOIN results r ON r.case_id=c.case_id "
          "WHERE cc.campaign_id=? ORDER BY c.law, c.aspect_ratio, coalesce(c.skalak_C,-1), c.mesh_level, "
          "c.capillary_number");
   s.bind(1, campaign_id);
   std::vector<CaseSample> out;
   while (s.step())
     out.push_back({s.text(0), CaseParams::from_json(s.text(1)), s.text(2), s.real(3), s.real(4), s.real(5), s.real(6),
-                   s.real(7)});
+                   s.real(7), s.text(8)});
   return out;
 }
 
@@ -628,6 +630,7 @@ std::vector<Transition> Store::transitions(std::int64_t campaign_id, int mesh_le
   const bool with_errors = has_column(*db_, "transitions", "role");  // schema 4
   const bool with_level_answers = has_column(*db_, "transitions", "level_answers");  // schema 5
   const bool with_lacks = has_column(*db_, "transitions", "ca_h_err_lacks");           // schema 6
+  const bool with_ts = has_column(*db_, "transitions", "ca_ts_low");                    // schema 7
   Stmt s(*db_, std::string("SELECT ") + (grouped ? "group_key" : "''") +
                    ", law, aspect_ratio, skalak_C, mesh_level, d12_threshold, n_samples, ca_star_low, ca_star_high, "
                    "ca_star_below, ca_star_above, ca_min_d12, ca_h, ca_h_low, ca_h_high, coalesce(ca_h_low_case,''), "
@@ -640,6 +643,7 @@ std::vector<Transition> Store::transitions(std::int64_t campaign_id, int mesh_le
                    (with_lacks ? ", coalesce(ca_star_low_err_lacks,''), coalesce(ca_star_high_err_lacks,''), "
                                  "coalesce(ca_h_err_lacks,'')"
                                : ", '', '', ''") +
+                   (with_ts ? ", ca_ts_low, ca_ts_high, coalesce(ca_ts_note,'')" : ", NULL, NULL, ''") +
                    " FROM transitions WHERE campaign_id=?1 "
                    "AND (?2 < 0 OR mesh_level = ?2) AND (?3 < -0.5 OR skalak_C = ?3 OR law='neo-hookean') "
                    "ORDER BY law, aspect_ratio, mesh_level DESC, 1");
@@ -679,6 +683,9 @@ std::vector<Transition> Store::transitions(std::int64_t campaign_id, int mesh_le
     t.ca_star_low_err_lacks = s.text(29);
     t.ca_star_high_err_lacks = s.text(30);
     t.ca_h_err_lacks = s.text(31);
+    t.ca_ts_low = s.real(32);
+    t.ca_ts_high = s.real(33);
+    t.ca_ts_note = s.text(34);
     out.push_back(std::move(t));
   }
   return out;

@@ -105,8 +105,8 @@ class Store {
   /// @brief Opens for writing, creating the file and schema if needed (one transaction, before any
   /// worker). A database of an older schema version this build can migrate (1 -> 2: adds the Slurm
   /// tables; 2 -> 3: transitions keyed by group; 3 -> 4: role and error columns of transitions; 4 -> 5: level
-  /// answers; 5 -> 6: the missing parts of each error) is migrated in one transaction; a newer or unknown version
-  /// is refused.
+  /// answers; 5 -> 6: the missing parts of each error; 6 -> 7: the regime-based transition Ca_TS) is migrated in one
+  /// transaction; a newer or unknown version is refused.
   /// @throws BadInput for a corrupt/foreign file or a version it cannot read (nothing written).
   static std::unique_ptr<Store> open_for_write(const std::string& path);
   /// @brief Opens an existing database read-only (queries, status, dry runs). An older version that
@@ -173,7 +173,7 @@ class Store {
   int requeue_failed(std::int64_t campaign_id);
   /// @brief Replaces the transitions of a campaign (one row per Transition::group_key).
   void save_transitions(std::int64_t campaign_id, const std::vector<Transition>& rows);
-  /// @brief Every case of a campaign with the metrics of its result (the input of the analysis).
+  /// @brief Every case of a campaign with the metrics and the regime of its result (the input of the analysis).
   std::vector<CaseSample> campaign_samples(std::int64_t campaign_id);
   /// @brief The stored transitions of a campaign (finest level first within law and a/b), with @p mesh_level
   /// (< 0: any) and @p skalak_C (< 0: any; neo-Hookean rows always) filters. A version-2 database has no

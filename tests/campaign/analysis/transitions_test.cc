@@ -140,6 +140,151 @@ TEST(Transitions, AnAllCompressedSphereBoundsNoCaH) {
   EXPECT_DOUBLE_EQ(*t.ca_h_high, 0.4);
 }
 
+// Samples at @p cas with the regimes @p regimes ("tumbling", "swinging", ...), D12 and tension that bracket
+// nothing of their own: Ca_TS must come from the regimes alone.
+std::vector<Sample> regime_samples(const std::vector<double>& cas, const std::vector<std::string>& regimes) {
+  std::vector<Sample> out;
+  for (std::size_t i = 0; i < cas.size(); ++i) {
+    out.push_back(sample(cas[i], 0.3, 0.1, "id" + std::to_string(i)));
+    out.back().regime = regimes[i];
+  }
+  return out;
+}
+
+Transition prolate() {
+  Transition key;
+  key.aspect_ratio = 2.0;
+  return key;
+}
+
+TEST(RegimeTransition, ACleanSequenceGivesTheAdjacentTumblingAndSwingingSamples) {
+  // NH a/b = 2 at λ = 1 (results/viscosity_ratio): tumbling up to 0.213, swinging from 0.25 (unsorted on purpose).
+  auto s = regime_samples({0.25, 0.05, 0.213, 0.4, 0.2, 0.3},
+                          {"swinging", "tumbling", "tumbling", "swinging", "tumbling", "swinging"});
+  const Transition t = analyse_group(prolate(), s, 0.05);
+  ASSERT_TRUE(t.ca_ts_low && t.ca_ts_high);
+  EXPECT_DOUBLE_EQ(*t.ca_ts_low, 0.213);
+  EXPECT_DOUBLE_EQ(*t.ca_ts_high, 0.25);
+  EXPECT_EQ(t.ca_ts_note, "");
+  // Independent of the Ca* criterion (min D12 0.3 everywhere: no Ca*), and its note stays the Ca* / CaH one.
+  EXPECT_FALSE(t.ca_star_low);
+  EXPECT_EQ(t.note.find("swing"), std::string::npos) << t.note;
+}
+
+TEST(RegimeTransition, EveryTumblingOrEverySwingingSampleGivesNoBracketAndSaysWhich) {
+  auto s = regime_samples({0.02, 0.5, 5}, {"tumbling", "tumbling", "tumbling"});
+  Transition t = analyse_group(prolate(), s, 0.05);
+  EXPECT_FALSE(t.ca_ts_low);
+  EXPECT_FALSE(t.ca_ts_high);
+  EXPECT_EQ(t.ca_ts_note, "tumbles at every sampled Ca (0.02 to 5)");
+  for (auto& x : s) x.regime = "swinging";
+  t = analyse_group(prolate(), s, 0.05);
+  EXPECT_FALSE(t.ca_ts_low);
+  EXPECT_FALSE(t.ca_ts_high);
+  EXPECT_EQ(t.ca_ts_note, "swings from the smallest sampled Ca (0.02)");
+  // One sample: its Ca alone.
+  t = analyse_group(prolate(), {s[1]}, 0.05);
+  EXPECT_EQ(t.ca_ts_note, "swings from the smallest sampled Ca (0.5)");
+  s[1].regime = "tumbling";
+  t = analyse_group(prolate(), {s[1]}, 0.05);
+  EXPECT_EQ(t.ca_ts_note, "tumbles at every sampled Ca (0.5)");
+  t = analyse_group(prolate(), {}, 0.05);
+  EXPECT_FALSE(t.ca_ts_low);
+  EXPECT_EQ(t.ca_ts_note, "no finished case");
+}
+
+TEST(RegimeTransition, NonMonotoneRegimesGiveTheOutermostBracketOrNone) {
+  // A tumbling sample (0.3) above a swinging one (0.25): the outermost bracket runs from the last tumbling sample
+  // below the first swinging one (0.2) to the first swinging sample above the last tumbling one (0.35).
+  auto s = regime_samples({0.1, 0.2, 0.25, 0.3, 0.35, 0.5},
+                          {"tumbling", "tumbling", "swinging", "tumbling", "swinging", "swinging"});
+  Transition t = analyse_group(prolate(), s, 0.05);
+  ASSERT_TRUE(t.ca_ts_low && t.ca_ts_high);
+  EXPECT_DOUBLE_EQ(*t.ca_ts_low, 0.2);
+  EXPECT_DOUBLE_EQ(*t.ca_ts_high, 0.35);
+  EXPECT_EQ(t.ca_ts_note.rfind(kRegimesNotMonotone, 0), 0u) << t.ca_ts_note;
+  EXPECT_EQ(t.ca_ts_note,
+            "regimes not monotone in Ca: tumbling at Ca=0.3 above swinging at Ca=0.25; the bracket is the outermost: "
+            "every sample below it tumbles, every one above it swings");
+  // Tumbling at the largest sample: no bracket has tumbling below and swinging above.
+  s[5].regime = "tumbling";
+  t = analyse_group(prolate(), s, 0.05);
+  EXPECT_FALSE(t.ca_ts_low);
+  EXPECT_FALSE(t.ca_ts_high);
+  EXPECT_EQ(t.ca_ts_note, "regimes not monotone in Ca: tumbling at Ca=0.5 above swinging at Ca=0.25; tumbling at the "
+                          "largest sampled Ca, so no bracket has tumbling below and swinging above");
+  // Swinging at the smallest sample, tumbling above: none either.
+  s = regime_samples({0.1, 0.2, 0.3}, {"swinging", "tumbling", "swinging"});
+  t = analyse_group(prolate(), s, 0.05);
+  EXPECT_FALSE(t.ca_ts_low);
+  EXPECT_FALSE(t.ca_ts_high);
+  EXPECT_EQ(t.ca_ts_note, "regimes not monotone in Ca: tumbling at Ca=0.2 above swinging at Ca=0.1; swinging at the "
+                          "smallest sampled Ca, so no bracket has tumbling below and swinging above");
+}
+
+TEST(RegimeTransition, SamplesOfOtherRegimesAreSkippedAndNamed) {
+  // Steady, unknown (no full period) and off-plane regimes (a tilted capsule's kayaking) are neither side of the
+  // in-plane transition: skipped, so the bracket joins the tumbling and swinging samples around them.
+  auto s = regime_samples({0.01, 0.05, 0.1, 0.15, 0.2, 0.3, 2, 3},
+                          {"tumbling", "kayaking", "tumbling", "steady", "swinging", "unknown", "swinging", "unknown"});
+  Transition t = analyse_group(prolate(), s, 0.05);
+  ASSERT_TRUE(t.ca_ts_low && t.ca_ts_high);
+  EXPECT_DOUBLE_EQ(*t.ca_ts_low, 0.1);
+  EXPECT_DOUBLE_EQ(*t.ca_ts_high, 0.2);
+  EXPECT_EQ(t.ca_ts_note, "skipped kayaking at Ca=0.05; skipped steady at Ca=0.15; skipped unknown at Ca=0.3, 3");
+  // Only skipped regimes (a result without one reads as ""): no bracket.
+  s = regime_samples({0.1, 0.2, 0.3}, {"rolling", "", "rolling"});
+  t = analyse_group(prolate(), s, 0.05);
+  EXPECT_FALSE(t.ca_ts_low);
+  EXPECT_FALSE(t.ca_ts_high);
+  EXPECT_EQ(t.ca_ts_note,
+            "no tumbling or swinging case; skipped rolling at Ca=0.1, 0.3; skipped no recorded regime at Ca=0.2");
+  // Skipped samples beside an all-tumbling sequence: the range is that of the tumbling samples.
+  s = regime_samples({0.1, 0.2, 0.3}, {"tumbling", "tumbling", "unknown"});
+  t = analyse_group(prolate(), s, 0.05);
+  EXPECT_EQ(t.ca_ts_note, "tumbles at every sampled Ca (0.1 to 0.2); skipped unknown at Ca=0.3");
+}
+
+TEST(RegimeTransition, ASphereGetsNothing) {
+  // A sphere does not tumble: even a sequence that would bracket a transition on a spheroid gives no Ca_TS.
+  auto s = regime_samples({0.1, 0.2, 0.3}, {"tumbling", "swinging", "steady"});
+  Transition key;
+  key.aspect_ratio = 1.0;
+  const Transition t = analyse_group(key, s, 0.05);
+  EXPECT_FALSE(t.ca_ts_low);
+  EXPECT_FALSE(t.ca_ts_high);
+  EXPECT_EQ(t.ca_ts_note, "");
+  EXPECT_FALSE(analyse_group(key, {}, 0.05).ca_ts_low);
+  EXPECT_EQ(analyse_group(key, {}, 0.05).ca_ts_note, "");
+}
+
+// group_cases hands each sample the regime of its case, and where a Ca was run twice, that of the kept case.
+TEST(RegimeTransition, GroupingCarriesTheRegimeOfTheKeptCase) {
+  std::vector<CaseSample> cases;
+  for (const auto& [ca, regime] : std::vector<std::pair<double, std::string>>{{0.1, "tumbling"}, {0.2, "swinging"}}) {
+    CaseParams p = CaseParams::defaults();
+    p.set("capsule.aspect_ratio", 2.0);
+    p.set("flow.capillary_number", ca);
+    CaseSample c;
+    c.case_id = "c" + std::to_string(ca);
+    c.params = p;
+    c.status = "done";
+    c.min_d12 = 0.3;
+    c.max_tau_min = 0.1;
+    c.regime = regime;
+    cases.push_back(c);
+  }
+  const auto groups = group_cases(cases);
+  ASSERT_EQ(groups.size(), 1u);
+  ASSERT_EQ(groups[0].samples.size(), 2u);
+  EXPECT_EQ(groups[0].samples[0].regime, "tumbling");
+  EXPECT_EQ(groups[0].samples[1].regime, "swinging");
+  const auto rows = analyse_groups(groups, 0.05, "grid");
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_DOUBLE_EQ(*rows[0].ca_ts_low, 0.1);
+  EXPECT_DOUBLE_EQ(*rows[0].ca_ts_high, 0.2);
+}
+
 TEST(Adaptive, ProposalsShrinkBracketsAndConverge) {
   // Start coarse, add the proposals of each round: the Ca* edges and CaH converge to the tolerance.
   std::vector<double> cas = {0.01, 0.1, 0.4, 0.8, 1.2};

@@ -30,7 +30,7 @@ std::string make_db(const std::string& dir) {
 }
 
 TEST(Store, SchemaVersionComesFromTheEmbeddedDdl) {
-  EXPECT_EQ(Store::expected_schema_version(), 6);  // schemas/006_error_lacks_v6.sql
+  EXPECT_EQ(Store::expected_schema_version(), 7);  // schemas/007_regime_transition_v7.sql
   EXPECT_NE(std::string(kSchemaSql).find("CREATE TABLE IF NOT EXISTS transitions"), std::string::npos);
 }
 
@@ -136,6 +136,37 @@ TEST(Store, ARunRefreshesTheCostEstimatesOfItsCases) {
     ++n;
   }
   EXPECT_EQ(n, 4);
+}
+
+// The regime-based transition goes into the transitions table and comes back as it went in: the bracket, or
+// none with the note that says why.
+TEST(Store, TransitionsKeepTheRegimeTransition) {
+  const std::string dir = fresh_dir("store_regime_transition");
+  const std::string db = make_db(dir);
+  auto store = Store::open_for_write(db);
+  const std::int64_t id = *store->find_campaign("tiny");
+  Transition bracket;
+  bracket.group_key = "{\"a\":1}";
+  bracket.law = "neo-hookean";
+  bracket.aspect_ratio = 2.0;
+  bracket.ca_ts_low = 0.213;
+  bracket.ca_ts_high = 0.25;
+  Transition none = bracket;
+  none.group_key = "{\"a\":2}";
+  none.aspect_ratio = 0.5;
+  none.ca_ts_low = none.ca_ts_high = std::nullopt;
+  none.ca_ts_note = "tumbles at every sampled Ca (0.02 to 5)";
+  store->save_transitions(id, {bracket, none});
+  const auto rows = store->transitions(id);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].aspect_ratio, 0.5);
+  EXPECT_FALSE(rows[0].ca_ts_low);
+  EXPECT_FALSE(rows[0].ca_ts_high);
+  EXPECT_EQ(rows[0].ca_ts_note, none.ca_ts_note);
+  EXPECT_EQ(rows[1].ca_ts_low, 0.213);
+  EXPECT_EQ(rows[1].ca_ts_high, 0.25);
+  EXPECT_EQ(rows[1].ca_ts_note, "");
+  EXPECT_EQ(sql(db, "SELECT count(*) FROM transitions WHERE ca_ts_note IS NULL"), "1\n") << "no note: NULL";
 }
 
 TEST(Store, SqlQueriesAreReadOnly) {

@@ -213,6 +213,34 @@ TEST_F(ScriptsTest, PlotsTheViscosityRatioFigureFromTheCommittedStudy) {
   EXPECT_NE(one.err.find("one viscosity ratio only"), std::string::npos) << one.err;
 }
 
+// Figure 8 (the regime map) from the committed stability study, its two levels given as two databases: a figure and a
+// table with a row per law × a/b × Ca × level and a column per starting tilt; a database without a tilted case is
+// refused with one message (exit 2), and so are several databases for another figure.
+TEST_F(ScriptsTest, PlotsTheRegimeMapFromTwoLevels) {
+  const auto out = dir_ / "fig8";
+  fs::remove_all(out);
+  fs::create_directories(out);
+  for (const char* name : {"stability.sqlite", "stability_level3.sqlite"}) {
+    const auto db = fs::path(kSrc) / "results/stability" / name;
+    ASSERT_TRUE(fs::exists(db)) << "the committed study is a deliverable";
+    fs::copy_file(db, out / name);  // queried read-only, but not in the source tree
+  }
+  const std::string dbs = " --db " + q(out / "stability.sqlite") + " --db " + q(out / "stability_level3.sqlite");
+  const Cmd r = sh(plot() + dbs + " --only 8 --out " + q(out));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(is_png(out / "regime_map_figure8.png"));
+  const std::string table = slurp(out / "regime_map_table.md");
+  EXPECT_EQ(count_lines(table), 2 + 12 * 2) << table;  // header, rule, 12 cells × Ca on 2 levels
+  EXPECT_NE(table.find("| from 5° |"), std::string::npos) << table;
+  EXPECT_NE(table.find("| Sk | 2 | 0.1 | 3 | kayaking"), std::string::npos) << table;
+  const Cmd flat = sh(plot() + " --db " + q(dir_ / "fixture.sqlite") + " --only 8 --out " + q(out / "flat"));
+  EXPECT_EQ(flat.code, 2) << flat.err;
+  EXPECT_NE(flat.err.find("no finished case started off the shear plane"), std::string::npos) << flat.err;
+  const Cmd other = sh(plot() + dbs + " --only 3 --out " + q(out / "other"));
+  EXPECT_EQ(other.code, 2) << other.err;
+  EXPECT_NE(other.err.find("several --db are for figure 8 alone"), std::string::npos) << other.err;
+}
+
 TEST_F(ScriptsTest, Table1FromTheDatabaseComparesCellByCell) {
   const auto md = dir_ / "table1.md";
   fs::remove(md);

@@ -328,7 +328,7 @@ TEST(CapsuleFlow, VelocityIsBitwiseTheSameOnOneAndTwoThreads) {
   }
 }
 
-// Any orientation rotated by a symmetry of the flow gives the rotated answer (issue 42, validation). The shear
+// Any orientation rotated by a symmetry of the flow gives the rotated answer (solver/README.md, Orientation). The shear
 // v∞ = (x2, 0, 0) is invariant under the half-turn about the vorticity axis, R = diag(−1, −1, 1): R v∞(x) = v∞(R x).
 // (The mirror x3 → −x3 and the point symmetry x → −x are its other symmetries, but they are reflections: applied to
 // node positions alone they turn the surface inside out, so the half-turn, their product, is the one a mesh can

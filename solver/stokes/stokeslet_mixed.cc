@@ -19,6 +19,12 @@ void to_float(const double* in, int n, std::vector<float>& out) {
   for (int i = 0; i < n; ++i) out[i] = static_cast<float>(in[i]);
 }
 
+// Targets padded to `padded` (whole tiles) with copies of the last one, whose results the tiles drop.
+void to_float_padded(const double* in, int n, int padded, std::vector<float>& out) {
+  out.resize(static_cast<std::size_t>(padded));
+  for (int i = 0; i < padded; ++i) out[i] = static_cast<float>(in[std::min(i, n - 1)]);
+}
+
 // The portable tiles' accumulation (without the SIMD lane types): per block of kMixedBlock sources,
 // add_chunk(j0, j1, ax, ay, az) adds the pairs of sources [j0, j1) to W float sums started at zero, which are
 // added into double ones; u overwritten. The float-lane counterpart is lanes::accumulate_mixed.
@@ -97,15 +103,9 @@ void sum_mixed_tiles(const Targets& t, const Sources& s, const Result& u) {
   // with the same sizes, so after the first call nothing is allocated.
   thread_local std::vector<float> tx, ty, tz;
   thread_local FloatSoA f;
-  tx.resize(static_cast<std::size_t>(padded));
-  ty.resize(tx.size());
-  tz.resize(tx.size());
-  for (int i = 0; i < padded; ++i) {
-    const int k = std::min(i, t.n - 1);
-    tx[i] = static_cast<float>(t.x[k]);
-    ty[i] = static_cast<float>(t.y[k]);
-    tz[i] = static_cast<float>(t.z[k]);
-  }
+  to_float_padded(t.x, t.n, padded, tx);
+  to_float_padded(t.y, t.n, padded, ty);
+  to_float_padded(t.z, t.n, padded, tz);
   to_float(s.x, s.n, f.x);
   to_float(s.y, s.n, f.y);
   to_float(s.z, s.n, f.z);
@@ -181,10 +181,7 @@ void stresslet_sum_mixed(const StressletTargets& t, const StressletSources& s, c
   thread_local std::vector<float> tf[6];
   thread_local StressletFloatSoA f;
   const double* tin[6] = {t.x, t.y, t.z, t.vx, t.vy, t.vz};
-  for (int k = 0; k < 6; ++k) {
-    tf[k].resize(static_cast<std::size_t>(padded));
-    for (int i = 0; i < padded; ++i) tf[k][i] = static_cast<float>(tin[k][std::min(i, t.n - 1)]);
-  }
+  for (int k = 0; k < 6; ++k) to_float_padded(tin[k], t.n, padded, tf[k]);
   to_float(s.x, s.n, f.x);
   to_float(s.y, s.n, f.y);
   to_float(s.z, s.n, f.z);

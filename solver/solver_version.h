@@ -8,5 +8,7 @@
 
 namespace capsim {
 /// @brief Numerical-results version of the solver.
-inline constexpr const char* kSolverVersion = "2";  // 2: volume correction on by default
+inline constexpr const char* kSolverVersion = "3";  // 2: volume correction on by default; 3: the flow
+// evaluation's phases rearranged (volume flux exact by flux moments, symmetry-reduced load solve): the same method,
+// results moved at round-off and CG-tolerance level (results/README.md, "Solver versions")
 }  // namespace capsim

@@ -53,7 +53,6 @@ CapsuleFlow::CapsuleFlow(const config::CaseConfig& c) : Ca_(c.capillary_number),
     second_kind_ = std::make_unique<ViscosityContrast>(*mesh_, dl, c.viscosity_ratio, ko);
   }
   volume_correction_ = c.volume_correction;
-  flux_rule_ = mesh::P2Tabulation::of_degree(6);
 }
 
 CapsuleFlow::~CapsuleFlow() = default;
@@ -185,30 +184,13 @@ FlowEvaluation CapsuleFlow::boundary_velocity(const Eigen::Matrix3Xd& x, const E
     if (background_flow_) u_.row(0) -= x.row(1);
     out.max_speed = u_.colwise().norm().maxCoeff();
   }
-  // Discrete flux of v and of the node normals through the P2 surface; remove the spurious part.
-  normals_ = mesh::node_normals(*mesh_, x);
-  // Per element in parallel, then summed in element order (deterministic for any thread count).
-  const int ne = mesh_->num_elements();
-  flux_v_.resize(static_cast<std::size_t>(ne));
-  flux_n_.resize(static_cast<std::size_t>(ne));
-#pragma omp parallel for schedule(static)
-  for (int e = 0; e < ne; ++e) {
-    const auto& el = mesh_->elements[e];
-    double fv = 0.0, fn = 0.0;
-    for (int k = 0; k < flux_rule_.size(); ++k) {
-      const auto [g1, g2] = flux_rule_.tangents(x, el, k);
-      const Eigen::Vector3d vq = flux_rule_.interpolate(v, el, k), nq = flux_rule_.interpolate(normals_, el, k);
-      const Eigen::Vector3d nda = flux_rule_.weight(k) * g1.cross(g2);
-      fv += vq.dot(nda);
-      fn += nq.dot(nda);
-    }
-    flux_v_[e] = fv;
-    flux_n_[e] = fn;
-  }
+  // Discrete flux of v and of the node normals through the P2 surface, Σ_i v_i · m_i with the nodes' flux moments
+  // (exact for P2 fields); remove the spurious part.
+  mesh::node_normals_and_flux_moments(*mesh_, x, normals_, flux_moments_, flux_scratch_);
   double flux_v = 0.0, flux_n = 0.0;
-  for (int e = 0; e < ne; ++e) {
-    flux_v += flux_v_[e];
-    flux_n += flux_n_[e];
+  for (Eigen::Index i = 0; i < x.cols(); ++i) {
+    flux_v += v.col(i).dot(flux_moments_.col(i));
+    flux_n += normals_.col(i).dot(flux_moments_.col(i));
   }
   out.volume_flux = flux_v;
   if (volume_correction_) v -= (flux_v / flux_n) * normals_;

@@ -10,7 +10,8 @@
 /// for a/b = 2, Ca = 0.9). The drift is not harmless: a capsule losing volume becomes flaccid and its
 /// tensions fall period after period (max τmin fell from +0.062 to +0.025 over five periods at level 3),
 /// which biases CaH. With the correction, v ← v − c n with n the node normals and c chosen so that the
-/// discrete flux ∫ v·n dS (P2 interpolation, exact geometry, degree-6 rule) is exactly zero: a uniform
+/// discrete flux ∫ v·n dS (P2 interpolation, exact geometry, integrated exactly: mesh::node_normals_and_flux_moments)
+/// is exactly zero: a uniform
 /// normal velocity of the size of the discretisation error, vanishing under refinement.
 
 #include <memory>
@@ -225,9 +226,8 @@ class CapsuleFlow {
   bool background_flow_ = true;
   bool volume_correction_ = true;
   // Rule of the flux integral: shape functions and derivatives at its points, weights · ½.
-  mesh::P2Tabulation flux_rule_;  // degree-6 rule of the volume-flux integral
-  Eigen::Matrix3Xd normals_;
-  std::vector<double> flux_v_, flux_n_;  // per-element fluxes of the volume correction
+  Eigen::Matrix3Xd normals_, flux_moments_;  // volume correction: node normals and flux moments on x
+  std::vector<double> flux_scratch_;          // their per-element work array
 };
 
 /// @brief Stable time step of the explicit two-stage scheme (rk2):

@@ -8,6 +8,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "solver/mesh/p2_element.h"
 #include "solver/mesh/p2_tabulation.h"
 
 namespace capsim::mesh {
@@ -316,22 +317,70 @@ double min_node_spacing(const SurfaceMesh& m, const Eigen::Matrix3Xd& x) {
 }
 
 Eigen::Matrix3Xd node_normals(const SurfaceMesh& m, const Eigen::Matrix3Xd& x) {
-  static const P2Tabulation nodes = P2Tabulation::at_nodes();
-  // Each element's unit normals at its nodes in parallel, then summed into the nodes serially in element order
-  // (the additions of a serial loop, in its order, for any thread count).
-  const int ne = m.num_elements();
-  std::vector<Eigen::Vector3d> at(static_cast<std::size_t>(ne) * 6);
-#pragma omp parallel for schedule(static)
-  for (int e = 0; e < ne; ++e)
-    for (int k = 0; k < 6; ++k) {
-      const auto [g1, g2] = nodes.tangents(x, m.elements[e], k);
-      at[static_cast<std::size_t>(e) * 6 + k] = g1.cross(g2).normalized();
-    }
-  Eigen::Matrix3Xd n = Eigen::Matrix3Xd::Zero(3, x.cols());
-  for (int e = 0; e < ne; ++e)
-    for (int k = 0; k < 6; ++k) n.col(m.elements[e][k]) += at[static_cast<std::size_t>(e) * 6 + k];
-  n.colwise().normalize();
+  Eigen::Matrix3Xd n, moments;
+  std::vector<double> scratch;
+  node_normals_and_flux_moments(m, x, n, moments, scratch);
   return n;
+}
+
+void node_normals_and_flux_moments(const SurfaceMesh& m, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& normals,
+                                   Eigen::Matrix3Xd& moments, std::vector<double>& scratch) {
+  node_normals_and_flux_moments(m.elements, x, normals, moments, scratch);
+}
+
+void node_normals_and_flux_moments(std::span<const std::array<int, 6>> elements, const Eigen::Matrix3Xd& x,
+                                   Eigen::Matrix3Xd& normals, Eigen::Matrix3Xd& moments, std::vector<double>& scratch) {
+  static const P2Tabulation nodes = P2Tabulation::at_nodes();
+  static const P2Tabulation rule = P2Tabulation::of_degree(4);
+  // Per element in parallel: the unit normals at its six nodes and its six moments (36 numbers), from the
+  // geometry in monomial form; then summed into the nodes serially in element order.
+  const int ne = static_cast<int>(elements.size()), nq = rule.size();
+  scratch.resize(static_cast<std::size_t>(ne) * 36);
+  double* out = scratch.data();
+#pragma omp parallel for schedule(static)
+  for (int e = 0; e < ne; ++e) {
+    const auto& el = elements[e];
+    double X[6][3], C[6][3];
+    for (int a = 0; a < 6; ++a)
+      for (int c = 0; c < 3; ++c) X[a][c] = x(c, el[a]);
+    p2_monomials3(X, C);
+    double* o = out + static_cast<std::size_t>(e) * 36;
+    for (int a = 0; a < 6; ++a) {
+      double p[3], g1[3], g2[3];
+      p2_monomial_geometry(C, nodes[a].xi, nodes[a].eta, p, g1, g2);
+      const double nx = g1[1] * g2[2] - g1[2] * g2[1], ny = g1[2] * g2[0] - g1[0] * g2[2],
+                   nz = g1[0] * g2[1] - g1[1] * g2[0];
+      const double inv = 1.0 / std::sqrt(nx * nx + ny * ny + nz * nz);
+      o[3 * a] = nx * inv;
+      o[3 * a + 1] = ny * inv;
+      o[3 * a + 2] = nz * inv;
+    }
+    double mom[6][3] = {};
+    for (int k = 0; k < nq; ++k) {
+      double p[3], g1[3], g2[3];
+      p2_monomial_geometry(C, rule[k].xi, rule[k].eta, p, g1, g2);
+      const double w = rule.weight(k);
+      const double nda[3] = {w * (g1[1] * g2[2] - g1[2] * g2[1]), w * (g1[2] * g2[0] - g1[0] * g2[2]),
+                             w * (g1[0] * g2[1] - g1[1] * g2[0])};
+      for (int a = 0; a < 6; ++a)
+        for (int c = 0; c < 3; ++c) mom[a][c] += rule[k].n[a] * nda[c];
+    }
+    for (int a = 0; a < 6; ++a)
+      for (int c = 0; c < 3; ++c) o[18 + 3 * a + c] = mom[a][c];
+  }
+  normals.setZero(3, x.cols());
+  moments.setZero(3, x.cols());
+  for (int e = 0; e < ne; ++e) {
+    const double* o = out + static_cast<std::size_t>(e) * 36;
+    for (int a = 0; a < 6; ++a) {
+      const int i = elements[e][a];
+      for (int c = 0; c < 3; ++c) {
+        normals(c, i) += o[3 * a + c];
+        moments(c, i) += o[18 + 3 * a + c];
+      }
+    }
+  }
+  normals.colwise().normalize();
 }
 
 bool symmetric_under(std::span<const int> image, const std::array<double, 3>& signs, const Eigen::Matrix3Xd& v,

@@ -125,6 +125,19 @@ double min_node_spacing(const SurfaceMesh& mesh, const Eigen::Matrix3Xd& x);
 /// elements around each node, evaluated at the node.
 Eigen::Matrix3Xd node_normals(const SurfaceMesh& mesh, const Eigen::Matrix3Xd& x);
 
+/// @brief node_normals and, in one pass over the elements, the flux moments of the nodes
+///   m_i = Σ_{e ∋ i} ∫ N_{a(e,i)}(ξ, η) (g1 × g2)(ξ, η) dξ dη,
+/// so that the flux of a P2 field v through the P2 surface is exactly ∫_S v·n dS = Σ_i v_i · m_i: the integrand
+/// v_h · (g1 × g2) is a quartic in (ξ, η) (v_h quadratic, the tangents linear), which the degree-4 rule
+/// integrates exactly. Sums over the elements are serial in element order (bitwise for any thread count).
+/// @param scratch per-element work array, reused between calls (resized as needed).
+void node_normals_and_flux_moments(const SurfaceMesh& mesh, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& normals,
+                                   Eigen::Matrix3Xd& moments, std::vector<double>& scratch);
+/// @brief The same for the elements of a mesh given by their connectivity alone (e.g. a boundary operator's copy);
+/// x has one column per node.
+void node_normals_and_flux_moments(std::span<const std::array<int, 6>> elements, const Eigen::Matrix3Xd& x,
+                                   Eigen::Matrix3Xd& normals, Eigen::Matrix3Xd& moments, std::vector<double>& scratch);
+
 /// @brief Parse a spheroid-map name ("conformal" | "equal-arc-length" | "axis-scaling").
 /// @throws std::invalid_argument naming the accepted values.
 SpheroidMap parse_spheroid_map(const std::string& name);

@@ -32,8 +32,8 @@ std::vector<double> shape_table(const std::vector<mesh::P2Point>& rule) {
 DoubleLayer::DoubleLayer(const mesh::SurfaceMesh& mesh, const SingleLayerOptions& options) : opt_(options) {
   if (std::string why; !opt_.valid(&why)) throw std::invalid_argument("stokes: " + why);
   topo_ = make_boundary_mesh(mesh);
-  rule_ = mesh::P2Tabulation::of_degree(opt_.regular_degree);
-  regular_.assign(rule_.points().begin(), rule_.points().end());
+  const mesh::P2Tabulation rule = mesh::P2Tabulation::of_degree(opt_.regular_degree);
+  regular_.assign(rule.points().begin(), rule.points().end());
   regular_shape_ = shape_table(regular_);
   for (int l = 0; l < 6; ++l) {
     const std::vector<mesh::P2Point> rule = duffy_rule(l, opt_.duffy_order);
@@ -326,23 +326,10 @@ Eigen::Matrix3Xd DoubleLayer::apply(const Eigen::Matrix3Xd& x, const Eigen::Matr
 Eigen::Matrix3Xd DoubleLayer::flux_weights(const Eigen::Matrix3Xd& x) const {
   if (x.cols() != topo_.num_nodes)
     throw std::invalid_argument("stokes: x must have " + std::to_string(topo_.num_nodes) + " columns");
-  // Per element in parallel, summed over elements serially in element order (bitwise the same on any number of
-  // threads).
-  const int ne = num_elements();
-  std::vector<Eigen::Matrix<double, 3, 6>> local(static_cast<std::size_t>(ne));
-#pragma omp parallel for schedule(static)
-  for (int e = 0; e < ne; ++e) {
-    const auto& el = topo_.elements[e];
-    local[e].setZero();
-    for (int q = 0; q < rule_.size(); ++q) {
-      const mesh::Tangents t = rule_.tangents(x, el, q);
-      const Eigen::Vector3d n = rule_.weight(q) * t.g1.cross(t.g2);
-      for (int a = 0; a < 6; ++a) local[e].col(a) += rule_[q].n[a] * n;
-    }
-  }
-  Eigen::Matrix3Xd a = Eigen::Matrix3Xd::Zero(3, topo_.num_nodes);
-  for (int e = 0; e < ne; ++e)
-    for (int k = 0; k < 6; ++k) a.col(topo_.elements[e][k]) += local[e].col(k);
+  // The nodes' flux moments (one owner: mesh::node_normals_and_flux_moments, exact for P2 fields).
+  Eigen::Matrix3Xd normals, a;
+  std::vector<double> scratch;
+  mesh::node_normals_and_flux_moments(topo_.elements, x, normals, a, scratch);
   return a;
 }
 

@@ -104,9 +104,9 @@ class DoubleLayer {
   [[nodiscard]] bool is_centrally_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) const;
 
   /// @brief The flux functional of the surface x: a (3 × num_nodes) with Σ_i a_i·v_i = ∫_S v·n dS for the P2
-  /// interpolant of any nodal field v, a_i = ∫_S N_i n dS over the elements of node i (n dS = g1 × g2 dξ dη, the
-  /// regular rule). Exact (to round-off) for fields whose interpolant times g1 × g2 has degree ≤ regular_degree,
-  /// in particular 0 for every rigid-body motion on any closed P2 surface (degree 4). The left eigenvector of
+  /// interpolant of any nodal field v, a_i = ∫_S N_i n dS over the elements of node i (n dS = g1 × g2 dξ dη; the
+  /// flux moments of mesh::node_normals_and_flux_moments, exact for every P2 field), in particular 0 for every
+  /// rigid-body motion on any closed P2 surface. The left eigenvector of
   /// the operator's eigenvalue 4π (∫ n·D[v] dS = 4π ∫ n·v dS on a closed surface) that the solve deflates.
   [[nodiscard]] Eigen::Matrix3Xd flux_weights(const Eigen::Matrix3Xd& x) const;
 
@@ -124,7 +124,6 @@ class DoubleLayer {
 
   SingleLayerOptions opt_;
   BoundaryMesh topo_;
-  mesh::P2Tabulation rule_;               // the regular rule (flux_weights)
   std::vector<mesh::P2Point> regular_;    // its points (layout)
   std::vector<double> regular_shape_;     // its shape functions (a-major SoA)
   PointTable duffy_[6];                   // Duffy rule per local node position (SoA)

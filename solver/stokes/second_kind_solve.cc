@@ -44,9 +44,11 @@ class SystemOperator {
     const Eigen::HouseholderQR<Eigen::MatrixXd> qr(rigid);
     q_ = qr.householderQ() * Eigen::MatrixXd::Identity(3 * n, 6);
     // The volume mode: left vector a (the flux), right vector u = n_h / (aᵀ n_h).
-    const Eigen::Matrix3Xd a = layer_.flux_weights(x);
+    // Both in one pass over the elements (a = DoubleLayer::flux_weights).
+    Eigen::Matrix3Xd normals, a;
+    std::vector<double> scratch;
+    mesh::node_normals_and_flux_moments(mesh, x, normals, a, scratch);
     a_ = Eigen::Map<const Vec>(a.data(), 3 * n);
-    const Eigen::Matrix3Xd normals = mesh::node_normals(mesh, x);
     u_ = Eigen::Map<const Vec>(normals.data(), 3 * n);
     u_ /= a_.dot(u_);
   }

@@ -64,15 +64,18 @@ void CapsuleFlow::begin_step() {
 
 void CapsuleFlow::set_second_kind_solve(std::unique_ptr<SecondKindSolve> solve) { second_kind_ = std::move(solve); }
 
-membrane::MembraneState CapsuleFlow::elastic_force(const Eigen::Matrix3Xd& x, bool& central) {
+membrane::MembraneState CapsuleFlow::elastic_force(const Eigen::Matrix3Xd& x, LoadSymmetry& symmetry) {
   const auto t0 = std::chrono::steady_clock::now();
   // With numerics.central_symmetry and a centrally symmetric x (to the boundary integral's position tolerance),
-  // half the elements, the others their images (MembraneMechanics::evaluate_centrally_symmetric); the load can
-  // then be solved for one node of each pair {i, −i} (LoadMatrix::AssembleCentral).
+  // half the elements, the others their images (MembraneMechanics::evaluate_centrally_symmetric). The load is
+  // then solved for one node of each orbit of the symmetries x has (LoadSolver::compute_load_symmetric): the
+  // mirror x3 → −x3, which the boundary integral uses whenever x and q have it (unless its symmetry is Off), and
+  // the point reflection with numerics.central_symmetry.
   const stokes::SingleLayerOptions& so = single_layer_->options();
-  central = so.central_symmetry && mesh::is_centrally_symmetric(*mesh_, x, so.symmetry_tol);
-  membrane::MembraneState s = central ? mechanics_->evaluate_centrally_symmetric(x, /*with_energy=*/false)
-                                      : mechanics_->evaluate(x, /*with_energy=*/false);
+  symmetry.central = so.central_symmetry && mesh::is_centrally_symmetric(*mesh_, x, so.symmetry_tol);
+  symmetry.mirror = so.symmetry != stokes::Symmetry::Off && mesh::is_mirror_symmetric(*mesh_, x, so.symmetry_tol);
+  membrane::MembraneState s = symmetry.central ? mechanics_->evaluate_centrally_symmetric(x, /*with_energy=*/false)
+                                               : mechanics_->evaluate(x, /*with_energy=*/false);
   timings_.membrane_s += seconds_since(t0);
   return s;
 }
@@ -84,12 +87,14 @@ void CapsuleFlow::bending_force(const Eigen::Matrix3Xd& x) {
 }
 
 void CapsuleFlow::solve_load(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, bool warm,
-                             LoadMatrix matrix) {
+                             LoadMatrix matrix, LoadSymmetry symmetry) {
   const auto t0 = std::chrono::steady_clock::now();
   try {
     switch (matrix) {
       case LoadMatrix::Factorised: load_solver_->solve(R, q, warm); break;
-      case LoadMatrix::AssembleCentral: load_solver_->compute_load_centrally_symmetric(x, R, q, warm); break;
+      case LoadMatrix::AssembleSymmetric:
+        load_solver_->compute_load_symmetric(x, R, q, warm, symmetry.mirror, symmetry.central);
+        break;
       case LoadMatrix::Assemble: load_solver_->compute_load(x, R, q, warm); break;
     }
   } catch (const std::runtime_error& e) {
@@ -103,24 +108,24 @@ membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Ei
 }
 
 membrane::MembraneState CapsuleFlow::membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q, bool warm) {
-  bool central = false;
-  const membrane::MembraneState s = elastic_force(x, central);
+  LoadSymmetry symmetry;
+  const membrane::MembraneState s = elastic_force(x, symmetry);
   if (!bending_) {
-    solve_load(x, s.internal_force, q, warm, central ? LoadMatrix::AssembleCentral : LoadMatrix::Assemble);
+    solve_load(x, s.internal_force, q, warm, LoadMatrix::AssembleSymmetric, symmetry);
     return s;
   }
   // With bending: its evaluation factorises the mass matrix on x (its two mass solves need it), and the load
   // solve reuses that factorisation for M q = R_elastic + R_b (on the full mesh: the bending evaluation has no
   // reduced form).
   bending_force(x);
-  solve_load(x, s.internal_force + bending_state_.internal_force, q, warm, LoadMatrix::Factorised);
+  solve_load(x, s.internal_force + bending_state_.internal_force, q, warm, LoadMatrix::Factorised, LoadSymmetry{});
   return s;
 }
 
 membrane::MembraneState CapsuleFlow::elastic_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q) {
-  bool central = false;
-  const membrane::MembraneState s = elastic_force(x, central);
-  solve_load(x, s.internal_force, q, false, central ? LoadMatrix::AssembleCentral : LoadMatrix::Assemble);
+  LoadSymmetry symmetry;
+  const membrane::MembraneState s = elastic_force(x, symmetry);
+  solve_load(x, s.internal_force, q, false, LoadMatrix::AssembleSymmetric, symmetry);
   return s;
 }
 
@@ -131,7 +136,7 @@ const membrane::BendingState& CapsuleFlow::bending_load(const Eigen::Matrix3Xd& 
     return bending_state_;
   }
   bending_force(x);
-  solve_load(x, bending_state_.internal_force, q, false, LoadMatrix::Factorised);
+  solve_load(x, bending_state_.internal_force, q, false, LoadMatrix::Factorised, LoadSymmetry{});
   return bending_state_;
 }
 

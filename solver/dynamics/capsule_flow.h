@@ -194,18 +194,24 @@ class CapsuleFlow {
  private:
   // How the load solve gets its mass matrix on x.
   enum class LoadMatrix {
-    Assemble,         // assemble and factorise M(x): compute_load
-    AssembleCentral,  // the same, reduced to one node of each pair {i, −i}: compute_load_centrally_symmetric
-    Factorised,       // M(x) already factorised by the bending evaluation on x: solve
+    Assemble,           // assemble and factorise M(x): compute_load
+    AssembleSymmetric,  // the same, reduced to one node of each orbit of x's symmetries: compute_load_symmetric
+                        // (compute_load when x has none)
+    Factorised,         // M(x) already factorised by the bending evaluation on x: solve
   };
-  // The elastic forces on x; `central`: whether x is centrally symmetric and the case uses it (then the forces
-  // are those of half the elements and their images). Timed as membrane_s.
-  membrane::MembraneState elastic_force(const Eigen::Matrix3Xd& x, bool& central);
+  // The symmetries of x the load solve uses (elastic_force decides).
+  struct LoadSymmetry {
+    bool mirror = false;   // x3 → −x3
+    bool central = false;  // x → −x (numerics.central_symmetry)
+  };
+  // The elastic forces on x, and the symmetries of x: with `central` the forces are those of half the elements
+  // and their images. Timed as membrane_s.
+  membrane::MembraneState elastic_force(const Eigen::Matrix3Xd& x, LoadSymmetry& symmetry);
   // The bending forces on x into bending_state_, leaving the load solver factorised on x. Timed as bending_s.
   void bending_force(const Eigen::Matrix3Xd& x);
   // M(x) q = R, from q's values when `warm` (LoadSolver::solve). Timed as load_s.
   void solve_load(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, bool warm,
-                  LoadMatrix matrix);
+                  LoadMatrix matrix, LoadSymmetry symmetry);
   // membrane_load, with the load solve started from q's values when `warm`.
   membrane::MembraneState membrane_load(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& q, bool warm);
 

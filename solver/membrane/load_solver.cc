@@ -15,6 +15,14 @@
 
 namespace capsim::membrane {
 
+namespace {
+bool all_finite(const double* v, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i)
+    if (!std::isfinite(v[i])) return false;
+  return true;
+}
+}  // namespace
+
 struct LoadSolver::Impl {
   Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> cholmod;
   std::vector<double> inv_diag;                              // Jacobi preconditioner of the CG backend
@@ -58,54 +66,6 @@ LoadSolver::LoadSolver(const mesh::SurfaceMesh& mesh, Options options)
     if (impl_->cholmod.info() != Eigen::Success) throw std::runtime_error("CHOLMOD: symbolic analysis failed");
   } else {
     central_ = mesh::central_elements(mesh);
-    if (!central_.empty()) build_reduced();
-  }
-}
-
-void LoadSolver::build_reduced() {
-  const int n = mesh_.num_nodes();
-  const auto& image = mesh_.central_node;
-  std::vector<int> reduced_of(static_cast<std::size_t>(n));
-  std::vector<double> sign(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i)
-    if (i < image[i]) {
-      reduced_of[i] = reduced_of[image[i]] = static_cast<int>(reduced_node_.size());
-      sign[i] = 1.0;
-      sign[image[i]] = -1.0;
-      reduced_node_.push_back(i);
-    }
-  // Row k of M̃ (node i): Σ_j M_ij q_j with q_j = sign_j q̃_reduced(j). M is stored symmetric, so column i of the
-  // compressed storage is row i.
-  const int nr = static_cast<int>(reduced_node_.size());
-  const int* outer = M_.outerIndexPtr();
-  const int* inner = M_.innerIndexPtr();
-  std::vector<std::vector<std::pair<int, int>>> entries(static_cast<std::size_t>(nr));  // (reduced col, M slot)
-  std::vector<Eigen::Triplet<double>> trip;
-  for (int k = 0; k < nr; ++k) {
-    const int i = reduced_node_[k];
-    for (int e = outer[i]; e < outer[i + 1]; ++e) {
-      entries[k].emplace_back(reduced_of[inner[e]], e);
-      trip.emplace_back(reduced_of[inner[e]], k, 1.0);
-    }
-  }
-  Mr_.resize(nr, nr);
-  Mr_.setFromTriplets(trip.begin(), trip.end());
-  Mr_.makeCompressed();
-  contrib_begin_.assign(static_cast<std::size_t>(Mr_.nonZeros()) + 1, 0);
-  std::vector<std::vector<std::pair<int, double>>> per_slot(static_cast<std::size_t>(Mr_.nonZeros()));
-  for (int k = 0; k < nr; ++k)
-    for (const auto& [l, slot] : entries[k]) {
-      const int* begin = Mr_.innerIndexPtr() + Mr_.outerIndexPtr()[k];
-      const int* end = Mr_.innerIndexPtr() + Mr_.outerIndexPtr()[k + 1];
-      const int s = static_cast<int>(std::lower_bound(begin, end, l) - Mr_.innerIndexPtr());
-      per_slot[s].emplace_back(slot, sign[inner[slot]]);
-    }
-  for (std::size_t s = 0; s < per_slot.size(); ++s) {
-    contrib_begin_[s + 1] = contrib_begin_[s] + static_cast<int>(per_slot[s].size());
-    for (const auto& [slot, sg] : per_slot[s]) {
-      contrib_slot_.push_back(slot);
-      contrib_sign_.push_back(sg);
-    }
   }
 }
 
@@ -200,17 +160,22 @@ void LoadSolver::solve(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, bool warm
         w.residual.row(c).setZero();
       }
     }
-    solve_cg(M_, w.inv_diag, w.residual, w.correction, reference2);
+    last_iterations_ = 0;
+    w.correction.resize(3, R.cols());
+    solve_cg<3>(M_, w.inv_diag, w.residual.data(), static_cast<int>(R.cols()), w.correction.data(), reference2);
     q += w.correction;
   } else {
-    solve_cg(M_, impl_->inv_diag, R, q);
+    last_iterations_ = 0;
+    q.resize(3, R.cols());
+    solve_cg<3>(M_, impl_->inv_diag, R.data(), static_cast<int>(R.cols()), q.data());
   }
 }
 
-void LoadSolver::solve_cg(const Eigen::SparseMatrix<double>& A, const std::vector<double>& inv_diag,
-                          const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, const double* reference2) {
-  // Jacobi-preconditioned CG from a zero guess on the three load components side by side: three independent
-  // CGs (each with its own α, β and stopping test |r_c| < tol |R_c|, Eigen's criterion) that share every
+template <int K>
+void LoadSolver::solve_cg(const Eigen::SparseMatrix<double>& A, const std::vector<double>& inv_diag, const double* b,
+                          int n, double* x, const double* reference2) {
+  // Jacobi-preconditioned CG from a zero guess on K load components side by side (K = 3, or the 1 or 2 components
+  // of one class of a symmetry-reduced solve): K independent CGs (each with its own α, β and stopping test |r_c| < tol |R_c|, Eigen's criterion) that share every
   // pass over M. A component that has converged is frozen.
   //
   // Two sweeps over the rows per iteration (the textbook loop makes four): the product is carried as
@@ -223,70 +188,68 @@ void LoadSolver::solve_cg(const Eigen::SparseMatrix<double>& A, const std::vecto
   // "Flow evaluation by phase"). The dot products are summed per block of kBlock rows and the block sums in
   // block order (the layout a parallel version would need), and q does not depend on the thread count.
   constexpr int kBlock = 256;
-  const int n = static_cast<int>(R.cols());
   const int nb = (n + kBlock - 1) / kBlock;
-  const std::size_t m = 3 * static_cast<std::size_t>(n);
+  const std::size_t m = K * static_cast<std::size_t>(n);
   Impl& w = *impl_;
   for (auto* v : {&w.r, &w.z, &w.p, &w.t}) v->resize(m);
-  w.partial.assign(static_cast<std::size_t>(nb) * 9, 0.0);
-  q.setZero(3, n);
-  double* x = q.data();
+  w.partial.assign(static_cast<std::size_t>(nb) * 3 * K, 0.0);
+  std::fill(x, x + m, 0.0);
   double *r = w.r.data(), *z = w.z.data(), *p = w.p.data(), *t = w.t.data();
   double* part_rr = w.partial.data();           // |r|² per block (and |b|² at the start)
-  double* part_rz = part_rr + 3 * nb;           // r·z per block
-  double* part_pt = part_rz + 3 * nb;           // p·t per block
+  double* part_rz = part_rr + K * nb;           // r·z per block
+  double* part_pt = part_rz + K * nb;           // p·t per block
   const double* d = inv_diag.data();
-  const double* b = R.data();
   const int* outer = A.outerIndexPtr();
   const int* inner = A.innerIndexPtr();
   const double* val = A.valuePtr();
   // M is SPD with a condition number bounded independently of h on any valid surface, so CG converges in a
   // few dozen iterations; the cap (twice the unknowns, as Eigen's) is reached only if M is not SPD.
   const int max_iterations = 2 * n;
-  double threshold[3] = {0, 0, 0}, residual2[3] = {0, 0, 0};
-  bool active[3] = {false, false, false};
-  int iterations[3] = {0, 0, 0};
+  double threshold[K] = {}, residual2[K] = {};
+  bool active[K] = {};
+  int iterations[K] = {};
+  auto any_active = [](const bool* a) {
+    bool any = false;
+    for (int c = 0; c < K; ++c) any = any || a[c];
+    return any;
+  };
   auto total = [nb](const double* part, int c) {  // Σ over blocks in block order
     double s = 0.0;
-    for (int k = 0; k < nb; ++k) s += part[3 * k + c];
+    for (int k = 0; k < nb; ++k) s += part[K * k + c];
     return s;
   };
-  // (M y)_i for row i, three components.
-  auto row_product = [&](const double* y, int i, double out[3]) {
-    double a0 = 0.0, a1 = 0.0, a2 = 0.0;
+  // (M y)_i for row i, K components.
+  auto row_product = [&](const double* y, int i, double out[K]) {
+    double acc[K] = {};
     for (int e = outer[i]; e < outer[i + 1]; ++e) {
       const double mv = val[e];
-      const double* yj = y + 3 * inner[e];
-      a0 += mv * yj[0];
-      a1 += mv * yj[1];
-      a2 += mv * yj[2];
+      const double* yj = y + K * inner[e];
+      for (int c = 0; c < K; ++c) acc[c] += mv * yj[c];
     }
-    out[0] = a0;
-    out[1] = a1;
-    out[2] = a2;
+    for (int c = 0; c < K; ++c) out[c] = acc[c];
   };
   {
-    double th[3], rz[3], alpha[3], res[3] = {0, 0, 0};
-    bool act[3];
-    int its[3] = {0, 0, 0};
+    double th[K], rz[K], alpha[K], res[K] = {};
+    bool act[K];
+    int its[K] = {};
     // Start: r = b, z = D⁻¹ r, p = z; |b|², r·z.
     for (int k = 0; k < nb; ++k) {
-      double bb[3] = {0, 0, 0}, s[3] = {0, 0, 0};
+      double bb[K] = {}, s[K] = {};
       for (int i = k * kBlock; i < std::min(n, (k + 1) * kBlock); ++i)
-        for (int c = 0; c < 3; ++c) {
-          const double bi = b[3 * i + c];
-          r[3 * i + c] = bi;
-          z[3 * i + c] = d[i] * bi;
-          p[3 * i + c] = z[3 * i + c];
+        for (int c = 0; c < K; ++c) {
+          const double bi = b[K * i + c];
+          r[K * i + c] = bi;
+          z[K * i + c] = d[i] * bi;
+          p[K * i + c] = z[K * i + c];
           bb[c] += bi * bi;
-          s[c] += bi * z[3 * i + c];
+          s[c] += bi * z[K * i + c];
         }
-      for (int c = 0; c < 3; ++c) {
-        part_rr[3 * k + c] = bb[c];
-        part_rz[3 * k + c] = s[c];
+      for (int c = 0; c < K; ++c) {
+        part_rr[K * k + c] = bb[c];
+        part_rz[K * k + c] = s[c];
       }
     }
-    for (int c = 0; c < 3; ++c) {
+    for (int c = 0; c < K; ++c) {
       const double bb = total(part_rr, c);
       th[c] = options_.cg_tolerance * options_.cg_tolerance * (reference2 ? reference2[c] : bb);
       rz[c] = total(part_rz, c);
@@ -294,33 +257,33 @@ void LoadSolver::solve_cg(const Eigen::SparseMatrix<double>& A, const std::vecto
     }
     // t = M p, p·t.
     for (int k = 0; k < nb; ++k) {
-      double pt[3] = {0, 0, 0};
+      double pt[K] = {};
       for (int i = k * kBlock; i < std::min(n, (k + 1) * kBlock); ++i) {
-        row_product(p, i, t + 3 * i);
-        for (int c = 0; c < 3; ++c) pt[c] += p[3 * i + c] * t[3 * i + c];
+        row_product(p, i, t + K * i);
+        for (int c = 0; c < K; ++c) pt[c] += p[K * i + c] * t[K * i + c];
       }
-      for (int c = 0; c < 3; ++c) part_pt[3 * k + c] = pt[c];
+      for (int c = 0; c < K; ++c) part_pt[K * k + c] = pt[c];
     }
-    for (int c = 0; c < 3; ++c) alpha[c] = act[c] ? rz[c] / total(part_pt, c) : 0.0;
-    for (int it = 0; it < max_iterations && (act[0] || act[1] || act[2]); ++it) {
+    for (int c = 0; c < K; ++c) alpha[c] = act[c] ? rz[c] / total(part_pt, c) : 0.0;
+    for (int it = 0; it < max_iterations && any_active(act); ++it) {
       // Sweep 1 (the frozen components keep x and r; their z and sums are computed but unused).
       for (int k = 0; k < nb; ++k) {
-        double rr[3] = {0, 0, 0}, s[3] = {0, 0, 0};
+        double rr[K] = {}, s[K] = {};
         for (int i = k * kBlock; i < std::min(n, (k + 1) * kBlock); ++i)
-          for (int c = 0; c < 3; ++c) {
-            x[3 * i + c] += alpha[c] * p[3 * i + c];
-            r[3 * i + c] -= alpha[c] * t[3 * i + c];
-            z[3 * i + c] = d[i] * r[3 * i + c];
-            rr[c] += r[3 * i + c] * r[3 * i + c];
-            s[c] += r[3 * i + c] * z[3 * i + c];
+          for (int c = 0; c < K; ++c) {
+            x[K * i + c] += alpha[c] * p[K * i + c];
+            r[K * i + c] -= alpha[c] * t[K * i + c];
+            z[K * i + c] = d[i] * r[K * i + c];
+            rr[c] += r[K * i + c] * r[K * i + c];
+            s[c] += r[K * i + c] * z[K * i + c];
           }
-        for (int c = 0; c < 3; ++c) {
-          part_rr[3 * k + c] = rr[c];
-          part_rz[3 * k + c] = s[c];
+        for (int c = 0; c < K; ++c) {
+          part_rr[K * k + c] = rr[c];
+          part_rz[K * k + c] = s[c];
         }
       }
-      double beta[3] = {0, 0, 0};
-      for (int c = 0; c < 3; ++c) {
+      double beta[K] = {};
+      for (int c = 0; c < K; ++c) {
         if (!act[c]) continue;
         ++its[c];
         res[c] = total(part_rr, c);
@@ -333,35 +296,35 @@ void LoadSolver::solve_cg(const Eigen::SparseMatrix<double>& A, const std::vecto
         beta[c] = s / rz[c];
         rz[c] = s;
       }
-      if (!(act[0] || act[1] || act[2])) break;
+      if (!any_active(act)) break;
       // Sweep 2.
       for (int k = 0; k < nb; ++k) {
-        double pt[3] = {0, 0, 0};
+        double pt[K] = {};
         for (int i = k * kBlock; i < std::min(n, (k + 1) * kBlock); ++i) {
-          double mz[3];
+          double mz[K];
           row_product(z, i, mz);
-          for (int c = 0; c < 3; ++c) {
+          for (int c = 0; c < K; ++c) {
             if (!act[c]) continue;
-            p[3 * i + c] = z[3 * i + c] + beta[c] * p[3 * i + c];
-            t[3 * i + c] = mz[c] + beta[c] * t[3 * i + c];
-            pt[c] += p[3 * i + c] * t[3 * i + c];
+            p[K * i + c] = z[K * i + c] + beta[c] * p[K * i + c];
+            t[K * i + c] = mz[c] + beta[c] * t[K * i + c];
+            pt[c] += p[K * i + c] * t[K * i + c];
           }
         }
-        for (int c = 0; c < 3; ++c) part_pt[3 * k + c] = pt[c];
+        for (int c = 0; c < K; ++c) part_pt[K * k + c] = pt[c];
       }
-      for (int c = 0; c < 3; ++c) alpha[c] = act[c] ? rz[c] / total(part_pt, c) : 0.0;
+      for (int c = 0; c < K; ++c) alpha[c] = act[c] ? rz[c] / total(part_pt, c) : 0.0;
     }
-    for (int c = 0; c < 3; ++c) {
+    for (int c = 0; c < K; ++c) {
       threshold[c] = th[c];
       residual2[c] = res[c];
       active[c] = act[c];
       iterations[c] = its[c];
     }
   }
-  last_iterations_ = iterations[0] + iterations[1] + iterations[2];
+  for (int c = 0; c < K; ++c) last_iterations_ += iterations[c];
   // Not converging, or a NaN anywhere, means M is not SPD (a NaN position, a collapsed surface).
-  for (int c = 0; c < 3; ++c)
-    if (active[c] || !std::isfinite(residual2[c]) || !q.row(c).allFinite())
+  for (int c = 0; c < K; ++c)
+    if (active[c] || !std::isfinite(residual2[c]) || !all_finite(x, m))
       throw DegenerateSurface("CG: the load solve did not converge (relative residual " +
                               std::to_string(std::sqrt(residual2[c] / std::max(threshold[c], 1e-300)) *
                                              options_.cg_tolerance) +
@@ -378,51 +341,231 @@ void LoadSolver::compute_load(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd&
 
 void LoadSolver::compute_load_centrally_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R,
                                                   Eigen::Matrix3Xd& q, bool warm) {
-  if (central_.empty() || options_.backend != Backend::ConjugateGradient) return compute_load(x, R, q, warm);
-  // Phases: assemble M from half the elements; M̃ and its Jacobi preconditioner; the reduced right side (R, or for
-  // the warm start R − M q0); CG; q from the reduced solution and its negated images.
-  assemble_elements(x, &central_.half);
-  Impl& w = *impl_;
-  const int nr = static_cast<int>(reduced_node_.size());
+  compute_load_symmetric(x, R, q, warm, /*mirror=*/false, /*central=*/true);
+}
+
+LoadSolver::Reduction LoadSolver::build_reduction(bool mirror, bool central) const {
+  // The group generated by the chosen symmetries, each element a node map and the signs it puts on the load's
+  // components (the load is a vector field equivariant with the positions).
+  struct Element {
+    const std::vector<int>* map;  // nullptr: the identity
+    std::vector<int> composed;    // the half-turn's map (mirror then x → −x)
+    std::array<double, 3> sign;
+  };
+  std::vector<Element> group{{nullptr, {}, {1.0, 1.0, 1.0}}};
+  if (mirror) group.push_back({&mesh_.mirror_node, {}, mesh::kMirrorSigns});
+  if (central) group.push_back({&mesh_.central_node, {}, mesh::kCentralSigns});
+  if (mirror && central) {
+    Element h{nullptr, std::vector<int>(mesh_.mirror_node.size()), {}};
+    for (std::size_t i = 0; i < h.composed.size(); ++i) h.composed[i] = mesh_.central_node[mesh_.mirror_node[i]];
+    for (int c = 0; c < 3; ++c) h.sign[c] = mesh::kMirrorSigns[c] * mesh::kCentralSigns[c];
+    group.push_back(std::move(h));
+  }
+  const int n = mesh_.num_nodes(), ng = static_cast<int>(group.size());
+  auto image = [&](int g, int i) {
+    const Element& el = group[g];
+    return el.map ? (*el.map)[i] : (el.composed.empty() ? i : el.composed[i]);
+  };
+  // Orbits, each represented by its smallest node; the sign of every node relative to its representative per
+  // group element that maps the representative onto it.
+  Reduction red;
+  red.orbit_of.assign(static_cast<std::size_t>(n), -1);
+  std::vector<int> orbit_size, stabiliser_flips;  // per orbit: size; bit c set: some g fixing the rep flips c
+  std::vector<std::array<double, 3>> node_sign(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    if (red.orbit_of[i] >= 0) continue;
+    const int o = static_cast<int>(red.representative.size());
+    red.representative.push_back(i);
+    int size = 0, flips = 0;
+    for (int g = 0; g < ng; ++g) {
+      const int j = image(g, i);
+      if (j == i)
+        for (int c = 0; c < 3; ++c)
+          if (group[g].sign[c] < 0.0) flips |= 1 << c;
+      if (red.orbit_of[j] < 0) {
+        red.orbit_of[j] = o;
+        node_sign[j] = group[g].sign;
+        ++size;
+      }
+    }
+    orbit_size.push_back(size);
+    stabiliser_flips.push_back(flips);
+  }
+  red.node_sign = node_sign;
+  // Components with the same signs under every group element share one reduced matrix (a class).
+  for (int c = 0; c < 3; ++c) {
+    bool placed = false;
+    for (Reduction::Class& cl : red.classes) {
+      bool same = true;
+      for (int g = 0; g < ng; ++g) same = same && group[g].sign[c] == group[g].sign[cl.components.front()];
+      if (same) {
+        cl.components.push_back(c);
+        placed = true;
+        break;
+      }
+    }
+    if (!placed) red.classes.push_back(Reduction::Class{{c}});
+  }
+  const int norbits = static_cast<int>(red.representative.size());
+  const double group_size = ng;
+  const int* outer = M_.outerIndexPtr();
+  const int* inner = M_.innerIndexPtr();
+  for (Reduction::Class& cl : red.classes) {
+    const int c0 = cl.components.front();
+    // Unknowns: the orbits whose representative's stabiliser keeps the class's sign (else the load is 0 there).
+    std::vector<int>& unknown_of = cl.unknown_of;
+    unknown_of.assign(static_cast<std::size_t>(norbits), -1);
+    for (int o = 0; o < norbits; ++o)
+      if (!(stabiliser_flips[o] & (1 << c0))) {
+        unknown_of[o] = static_cast<int>(cl.orbit.size());
+        cl.orbit.push_back(o);
+        cl.scale.push_back(std::sqrt(orbit_size[o] / group_size));
+      }
+    // Row of unknown u (orbit O, representative r): A'_{O,O'} = sqrt(|O|/|O'|) Σ_{j ∈ O'} s_j M_{r j}, the Galerkin
+    // matrix BᵀMB of the symmetric loads scaled symmetrically by the orbit sizes (see the header).
+    const int nu = static_cast<int>(cl.orbit.size());
+    std::vector<std::vector<std::pair<int, int>>> entries(static_cast<std::size_t>(nu));  // (column, M slot)
+    std::vector<Eigen::Triplet<double>> trip;
+    for (int u = 0; u < nu; ++u) {
+      const int r = red.representative[cl.orbit[u]];
+      for (int e = outer[r]; e < outer[r + 1]; ++e) {
+        const int col = unknown_of[red.orbit_of[inner[e]]];
+        if (col < 0) continue;  // a node whose load component is 0 by symmetry
+        entries[u].emplace_back(col, e);
+        trip.emplace_back(col, u, 1.0);
+      }
+    }
+    cl.A.resize(nu, nu);
+    cl.A.setFromTriplets(trip.begin(), trip.end());
+    cl.A.makeCompressed();
+    std::vector<std::vector<std::pair<int, double>>> per_slot(static_cast<std::size_t>(cl.A.nonZeros()));
+    cl.diagonal_slot.assign(static_cast<std::size_t>(nu), -1);
+    for (int u = 0; u < nu; ++u) {
+      const int* begin = cl.A.innerIndexPtr() + cl.A.outerIndexPtr()[u];
+      const int* end = cl.A.innerIndexPtr() + cl.A.outerIndexPtr()[u + 1];
+      for (const auto& [col, slot] : entries[u]) {
+        const int at = static_cast<int>(std::lower_bound(begin, end, col) - cl.A.innerIndexPtr());
+        const int j = inner[slot];
+        const double size_ratio = static_cast<double>(orbit_size[cl.orbit[u]]) / orbit_size[red.orbit_of[j]];
+        per_slot[at].emplace_back(slot, node_sign[j][c0] * (size_ratio == 1.0 ? 1.0 : std::sqrt(size_ratio)));
+      }
+      cl.diagonal_slot[u] = static_cast<int>(std::lower_bound(begin, end, u) - cl.A.innerIndexPtr());
+    }
+    cl.contrib_begin.assign(per_slot.size() + 1, 0);
+    for (std::size_t k = 0; k < per_slot.size(); ++k) {
+      cl.contrib_begin[k + 1] = cl.contrib_begin[k] + static_cast<int>(per_slot[k].size());
+      for (const auto& [slot, coef] : per_slot[k]) {
+        cl.contrib_slot.push_back(slot);
+        cl.contrib_coef.push_back(coef);
+      }
+    }
+  }
+  return red;
+}
+
+template <int K>
+void LoadSolver::solve_class(Reduction::Class& cl, const Reduction& red, const Eigen::Matrix3Xd& b,
+                             const double* reference2, Eigen::Matrix3Xd& out) {
+  // A' from the assembled M, its Jacobi preconditioner, b' = sqrt(|O|/|G|) b_r, CG, then the loads of the
+  // representatives q_r = q'_O / sqrt(|O|/|G|) and of their images by sign.
   const double* val = M_.valuePtr();
-  double* rv = Mr_.valuePtr();
-  for (Eigen::Index s = 0; s < Mr_.nonZeros(); ++s) {
+  double* av = cl.A.valuePtr();
+  for (Eigen::Index k = 0; k < cl.A.nonZeros(); ++k) {
     double v = 0.0;
-    for (int c = contrib_begin_[s]; c < contrib_begin_[s + 1]; ++c) v += contrib_sign_[c] * val[contrib_slot_[c]];
-    rv[s] = v;
+    for (int t = cl.contrib_begin[k]; t < cl.contrib_begin[k + 1]; ++t) v += cl.contrib_coef[t] * val[cl.contrib_slot[t]];
+    av[k] = v;
   }
-  w.inv_diag_reduced.resize(static_cast<std::size_t>(nr));
-  const Eigen::VectorXd dr = Mr_.diagonal();
-  for (int k = 0; k < nr; ++k) w.inv_diag_reduced[k] = dr[k] > 0.0 ? 1.0 / dr[k] : 1.0;
+  const int nu = static_cast<int>(cl.orbit.size());
+  cl.inv_diag.resize(static_cast<std::size_t>(nu));
+  for (int u = 0; u < nu; ++u) {
+    const double d = av[cl.diagonal_slot[u]];
+    cl.inv_diag[u] = d > 0.0 ? 1.0 / d : 1.0;
+  }
+  cl.rhs.resize(static_cast<std::size_t>(K) * nu);
+  cl.solution.resize(cl.rhs.size());
+  for (int u = 0; u < nu; ++u) {
+    const int r = red.representative[cl.orbit[u]];
+    for (int k = 0; k < K; ++k) cl.rhs[K * u + k] = cl.scale[u] * b(cl.components[k], r);
+  }
+  double reference[K];
+  if (reference2)
+    for (int k = 0; k < K; ++k) reference[k] = reference2[cl.components[k]];
+  solve_cg<K>(cl.A, cl.inv_diag, cl.rhs.data(), nu, cl.solution.data(), reference2 ? reference : nullptr);
+  const int n = mesh_.num_nodes();
+  for (int j = 0; j < n; ++j) {
+    const int u = cl.unknown_of[red.orbit_of[j]];
+    for (int k = 0; k < K; ++k) {
+      const int c = cl.components[k];
+      out(c, j) = u < 0 ? 0.0 : red.node_sign[j][c] * (cl.solution[K * u + k] / cl.scale[u]);
+    }
+  }
+}
+
+void LoadSolver::compute_load_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q,
+                                        bool warm, bool mirror, bool central) {
+  const bool have_mirror = mirror && static_cast<int>(mesh_.mirror_node.size()) == mesh_.num_nodes();
+  const bool have_central = central && !central_.empty();
+  if (options_.backend != Backend::ConjugateGradient || !(have_mirror || have_central))
+    return compute_load(x, R, q, warm);
+  // Phases: assemble M (from half the elements under x → −x, the others their images); the reduced right side
+  // (R, or for the warm start R − M q0, at the representatives); per class of components, A', CG and the loads.
+  assemble_elements(x, have_central ? &central_.half : nullptr);
+  const int index = (have_mirror ? 1 : 0) + (have_central ? 2 : 0) - 1;
+  if (!reductions_[index]) reductions_[index] = std::make_unique<Reduction>(build_reduction(have_mirror, have_central));
+  Reduction& red = *reductions_[index];
+  Impl& w = *impl_;
+  const int n = mesh_.num_nodes();
   const bool from_guess = warm && q.rows() == 3 && q.cols() == R.cols();
-  w.reduced_rhs.resize(3, nr);
   double reference2[3] = {0.0, 0.0, 0.0};
-  if (from_guess) w.residual.noalias() = R - q * M_;  // as solve(): M symmetric
-  for (int k = 0; k < nr; ++k) {
-    const int i = reduced_node_[k];
-    if (from_guess)
-      w.reduced_rhs.col(k) = w.residual.col(i);
-    else
-      w.reduced_rhs.col(k) = R.col(i);
-    if (from_guess)  // the warm start's stopping reference |R_c|² (a cold solve takes it from its right side)
-      for (int c = 0; c < 3; ++c) reference2[c] += R(c, i) * R(c, i);
-  }
-  if (from_guess)
+  const Eigen::Matrix3Xd* b = &R;
+  if (from_guess) {
+    // R − M q0 at the representatives only (the other rows follow by symmetry); the stopping reference is the
+    // full |R_c|², in the reduced norm Σ_O (|O|/|G|) |R_r|², which the scaled reduced right side has.
+    w.residual.resize(3, n);
+    const int* outer = M_.outerIndexPtr();
+    const int* inner = M_.innerIndexPtr();
+    const double* val = M_.valuePtr();
+    for (int r : red.representative) {
+      double acc[3] = {0.0, 0.0, 0.0};
+      for (int e = outer[r]; e < outer[r + 1]; ++e)
+        for (int c = 0; c < 3; ++c) acc[c] += val[e] * q(c, inner[e]);
+      for (int c = 0; c < 3; ++c) w.residual(c, r) = R(c, r) - acc[c];
+    }
+    for (const Reduction::Class& cl : red.classes)
+      for (std::size_t u = 0; u < cl.orbit.size(); ++u) {
+        const int r = red.representative[cl.orbit[u]];
+        for (int c : cl.components) reference2[c] += cl.scale[u] * cl.scale[u] * R(c, r) * R(c, r);
+      }
     for (int c = 0; c < 3; ++c)
       if (reference2[c] == 0.0) {  // a zero component has the solution 0 (as in solve())
         q.row(c).setZero();
-        w.reduced_rhs.row(c).setZero();
+        for (int r : red.representative) w.residual(c, r) = 0.0;
       }
-  solve_cg(Mr_, w.inv_diag_reduced, w.reduced_rhs, w.reduced_q, from_guess ? reference2 : nullptr);
-  if (!from_guess) q.setZero(3, R.cols());
-  for (int k = 0; k < nr; ++k) {
-    const int i = reduced_node_[k], p = mesh_.central_node[i];
-    if (from_guess) {
-      q.col(i) += w.reduced_q.col(k);
-      q.col(p) = -q.col(i);
-    } else {
-      q.col(i) = w.reduced_q.col(k);
-      q.col(p) = -w.reduced_q.col(k);
+    b = &w.residual;
+  }
+  last_iterations_ = 0;
+  Eigen::Matrix3Xd& out = from_guess ? w.correction : q;
+  out.resize(3, n);
+  for (Reduction::Class& cl : red.classes) {
+    const double* ref = from_guess ? reference2 : nullptr;
+    switch (cl.components.size()) {
+      case 1: solve_class<1>(cl, red, *b, ref, out); break;
+      case 2: solve_class<2>(cl, red, *b, ref, out); break;
+      default: solve_class<3>(cl, red, *b, ref, out); break;
+    }
+  }
+  if (from_guess) {
+    // q0 + δ at the representatives (0 where the symmetry says so), then the images by sign: q is exactly symmetric.
+    for (const Reduction::Class& cl : red.classes)
+      for (int c : cl.components)
+        for (int o = 0; o < static_cast<int>(red.representative.size()); ++o) {
+          const int r = red.representative[o];
+          q(c, r) = cl.unknown_of[o] < 0 ? 0.0 : q(c, r) + w.correction(c, r);
+        }
+    for (int j = 0; j < n; ++j) {
+      const int r = red.representative[red.orbit_of[j]];
+      if (j != r)
+        for (int c = 0; c < 3; ++c) q(c, j) = red.node_sign[j][c] * q(c, r);
     }
   }
 }

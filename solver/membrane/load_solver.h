@@ -4,7 +4,9 @@
 /// M_ab = ∫_S φ_a φ_b dS is the P2 mass matrix on the *deformed* surface and R = ∂W/∂x.
 /// q is the load the fluids exert on the membrane (∇s·τ + q = 0): outward on an inflated sphere.
 
+#include <array>
 #include <memory>
+#include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -55,13 +57,22 @@ class LoadSolver {
   void solve(const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, bool warm = false);
   /// @brief assemble(x), factorize(), solve(R, q, warm) in one call.
   void compute_load(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, bool warm = false);
-  /// @brief The same for x centrally symmetric and R odd under x → −x (x_P(i) = −x_i, R_P(i) = −R_i to round-off;
-  /// the caller checks — CapsuleFlow with numerics.central_symmetry): q is odd too, so with q_P(i) = −q_i the
-  /// system is solved for one node of each pair {i, P(i)}, the reduced matrix M̃_ij = M_ij − M_i,P(j) (symmetric
-  /// positive definite: M restricted to the odd loads), half the unknowns; element mass matrices are computed for
-  /// half the elements (an element's is its image's, permuted). The residual test is the same relative one (the
-  /// full residual is the reduced one and its negated image). q agrees with compute_load's to the CG tolerance,
-  /// and is exactly odd. CG backend only; otherwise, or without a central map, it is compute_load.
+  /// @brief compute_load for x symmetric under the mirror x3 → −x3 (mesh.mirror_node) and/or the point reflection
+  /// x → −x (mesh.central_node), and R equivariant with it (R_g(i) = S_g R_i, S_g the signs mesh::kMirrorSigns,
+  /// kCentralSigns; to round-off — the caller checks x: CapsuleFlow). q is then equivariant too, so M q = R is
+  /// solved on the symmetric loads only: with B the map from one value per orbit of the group (its smallest node,
+  /// the representative) to all nodes (q_g(r) = S_g q_r; a component that a symmetry fixing r flips is 0 there, e.g.
+  /// q3 on the mirror plane), the Galerkin system Bᵀ M B q̂ = Bᵀ R, scaled symmetrically by the orbit sizes
+  /// (W = diag(|O|/|G|)): A' = W^{−1/2} Bᵀ M B W^{−1/2} / |G|, b' = W^{−1/2} Bᵀ R / |G| = sqrt(|O|/|G|) R_r. A' is SPD,
+  /// and |b' − A' q'|² = |R − M q|² / |G| for equivariant fields, so the CG's relative residual test is the full
+  /// solve's. Components with the same signs under every group element share one A' (mirror: q1, q2 | q3; x → −x:
+  /// all three; both: q1, q2 | q3) and are solved side by side. Element mass matrices are computed for half the
+  /// elements under x → −x (an element's is its image's, permuted). One unknown per orbit: half the unknowns
+  /// with one symmetry, a quarter with both. q agrees with compute_load's to the CG tolerance and is exactly
+  /// equivariant. CG backend only; otherwise, or without the maps the symmetries need, it is compute_load.
+  void compute_load_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, bool warm,
+                              bool mirror, bool central);
+  /// @brief compute_load_symmetric with the point reflection alone (numerics.central_symmetry without the mirror).
   void compute_load_centrally_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q,
                                         bool warm = false);
 
@@ -71,25 +82,44 @@ class LoadSolver {
   [[nodiscard]] int last_iterations() const { return last_iterations_; }
 
  private:
-  // CG on the matrix A with Jacobi preconditioner inv_diag from zero, stopped at |r_c|² < cg_tolerance² ·
-  // reference2[c] (nullptr: |R_c|²).
-  void solve_cg(const Eigen::SparseMatrix<double>& A, const std::vector<double>& inv_diag, const Eigen::Matrix3Xd& R,
-                Eigen::Matrix3Xd& q, const double* reference2 = nullptr);
+  // The reduced systems of one symmetry group (compute_load_symmetric), built on first use.
+  struct Reduction {
+    struct Class {
+      std::vector<int> components;   // the load components solved side by side (1 to 3)
+      std::vector<int> orbit;        // unknown → orbit
+      std::vector<int> unknown_of;   // orbit → unknown (−1: the components are 0 on that orbit)
+      std::vector<double> scale;     // per unknown sqrt(|O| / |G|)
+      Eigen::SparseMatrix<double> A;  // A' (pattern built once, values per solve)
+      std::vector<int> diagonal_slot;  // per unknown, its diagonal entry in A
+      // Each value of A' as Σ coefficient · (value of M): slot k's terms are [contrib_begin[k], contrib_begin[k+1]).
+      std::vector<int> contrib_begin, contrib_slot;
+      std::vector<double> contrib_coef;
+      std::vector<double> inv_diag, rhs, solution;  // per solve
+    };
+    std::vector<int> representative;                 // orbit → its smallest node
+    std::vector<int> orbit_of;                       // node → orbit
+    std::vector<std::array<double, 3>> node_sign;    // node → S_g of the g mapping its representative onto it
+    std::vector<Class> classes;
+  };
+  Reduction build_reduction(bool mirror, bool central) const;
+  template <int K>
+  void solve_class(Reduction::Class& cl, const Reduction& red, const Eigen::Matrix3Xd& b, const double* reference2,
+                   Eigen::Matrix3Xd& out);
+  // CG on the matrix A with Jacobi preconditioner inv_diag from zero for K components (b and x are K × n,
+  // column-major), stopped at |r_c|² < cg_tolerance² · reference2[c] (nullptr: |b_c|²); adds its iterations to
+  // last_iterations_.
+  template <int K>
+  void solve_cg(const Eigen::SparseMatrix<double>& A, const std::vector<double>& inv_diag, const double* b, int n,
+                double* x, const double* reference2 = nullptr);
   // Element mass matrices (of `elements`, all when null, the others as their images), summed into M.
   void assemble_elements(const Eigen::Matrix3Xd& x, const std::vector<int>* elements);
-  // The reduced system of compute_load_centrally_symmetric, built once (constructor).
-  void build_reduced();
   struct Impl;
   const mesh::SurfaceMesh& mesh_;
   Options options_;
   Eigen::SparseMatrix<double> M_;
   std::vector<int> value_index_;  // element-major 6×6 → position in M_.valuePtr()
-  mesh::CentralElements central_;  // x → −x on elements (empty: no reduced solve)
-  std::vector<int> reduced_node_;  // reduced unknown → its node (the smaller index of each pair {i, P(i)})
-  Eigen::SparseMatrix<double> Mr_;  // the reduced matrix M̃ (pattern built once)
-  // Each value of M̃ as Σ sign · (value of M): the contributions of slot s are [contrib_begin_[s], contrib_begin_[s+1]).
-  std::vector<int> contrib_begin_, contrib_slot_;
-  std::vector<double> contrib_sign_;
+  mesh::CentralElements central_;  // x → −x on elements (empty: no map)
+  std::unique_ptr<Reduction> reductions_[3];  // mirror, x → −x, both
   std::unique_ptr<Impl> impl_;
   int last_iterations_ = 0;
 };

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <string>
+#include <utility>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -240,48 +242,70 @@ TEST(MembraneMechanics, CentrallySymmetricEvaluationHasTheSameForcesAndTensions)
   EXPECT_TRUE(no_map.evaluate_centrally_symmetric(x).internal_force == full.internal_force);
 }
 
-// The load of a centrally symmetric state solved for one node of each pair {i, −i} (numerics.central_symmetry):
-// the full solve's q to the CG tolerance, exactly odd, with half the unknowns; cold and warm-started.
-TEST(LoadSolver, CentrallySymmetricSolveGivesTheFullSolvesLoad) {
+// The load of a symmetric state solved for one node of each orbit of its symmetries (the mirror x3 → −x3, the point
+// reflection x → −x of numerics.central_symmetry, or both): the full solve's q to the CG tolerance, exactly
+// equivariant (q3 = 0 on the mirror plane), meeting the full residual test, with a half or a quarter of the
+// unknowns; cold and warm-started.
+TEST(LoadSolver, SymmetryReducedSolveGivesTheFullSolvesLoad) {
   const auto m = mesh::make_capsule_mesh(2, 2.0);
   const SkalakLaw law(1.0);
   const MembraneMechanics mech(m, m.nodes, law);
-  Matrix3Xd x0 = m.nodes, x1;
-  for (int i = 0; i < x0.cols(); ++i) {
-    const double a = m.nodes(0, i), b = m.nodes(1, i), c = m.nodes(2, i);
-    x0(0, i) = 1.2 * a + 0.3 * b + 0.1 * a * b * b;
-    x0(1, i) = 0.85 * b - 0.2 * a * a * a;
-    x0(2, i) = 0.95 * c + 0.15 * a;
-  }
-  mesh::symmetrise(m, x0, false, true);
-  x1 = 1.001 * x0;
-  const double tol = 1e-10;
-  LoadSolver::Options o;
-  o.cg_tolerance = tol;
-  LoadSolver full(m, o), reduced(m, o);
-  for (const bool warm : {false, true}) {
-    Matrix3Xd qf, qr;
-    if (warm) {  // the guess: the load of a nearby state, as the previous stage's
-      const Matrix3Xd R0 = mech.evaluate_centrally_symmetric(x0).internal_force;
-      full.compute_load(x0, R0, qf);
-      reduced.compute_load_centrally_symmetric(x0, R0, qr);
+  for (const auto& [mirror, central] : {std::pair{false, true}, std::pair{true, false}, std::pair{true, true}}) {
+    SCOPED_TRACE(std::string(mirror ? "mirror " : "") + (central ? "central" : ""));
+    Matrix3Xd x0 = m.nodes, x1;
+    for (int i = 0; i < x0.cols(); ++i) {
+      const double a = m.nodes(0, i), b = m.nodes(1, i), c = m.nodes(2, i);
+      // Odd in (a, b) and even in c for x1, x2, odd in c for x3: a map with both symmetries, and with the mirror
+      // alone once an even term breaks x → −x.
+      x0(0, i) = 1.2 * a + 0.3 * b + 0.1 * a * b * b + 0.05 * a * c * c + (central ? 0.0 : 0.08 * b * b);
+      x0(1, i) = 0.85 * b - 0.2 * a * a * a + 0.04 * b * c * c;
+      x0(2, i) = 0.95 * c + (mirror ? 0.1 * a * a * c : 0.15 * a);
     }
-    const Matrix3Xd R = mech.evaluate_centrally_symmetric(x1).internal_force;
-    full.compute_load(x1, R, qf, warm);
-    const int full_iterations = full.last_iterations();
-    reduced.compute_load_centrally_symmetric(x1, R, qr, warm);
-    const double scale = qf.cwiseAbs().maxCoeff();
-    const double diff = (qr - qf).cwiseAbs().maxCoeff() / scale;
-    std::printf("  %s: reduced vs full load, max diff / max |q| = %.2e (CG iterations %d and %d)\n",
-                warm ? "warm" : "cold", diff, reduced.last_iterations(), full_iterations);
-    // Both stop at |R − M q| ≤ tol |R|; the load error is about the residual times the condition number (≈ 10).
-    EXPECT_LT(diff, 1e3 * tol);
-    EXPECT_GT(reduced.last_iterations(), 0);
-    for (int i = 0; i < m.num_nodes(); ++i)
-      for (int c = 0; c < 3; ++c) ASSERT_EQ(qr(c, m.central_node[i]), -qr(c, i));
-    // The reduced solution meets the full residual test: |R − M q| ≤ tol |R| per component (M of x1).
-    const Matrix3Xd res = R - qr * full.mass_matrix();
-    for (int c = 0; c < 3; ++c) EXPECT_LE(res.row(c).norm(), 1.01 * tol * R.row(c).norm()) << "component " << c;
+    mesh::symmetrise(m, x0, mirror, central);
+    ASSERT_EQ(mesh::is_mirror_symmetric(m, x0, 1e-12), mirror);
+    ASSERT_EQ(mesh::is_centrally_symmetric(m, x0, 1e-12), central);
+    x1 = 1.001 * x0;
+    const double tol = 1e-10;
+    LoadSolver::Options o;
+    o.cg_tolerance = tol;
+    LoadSolver full(m, o), reduced(m, o);
+    auto force = [&](const Matrix3Xd& x) {
+      return central ? mech.evaluate_centrally_symmetric(x).internal_force : mech.evaluate(x).internal_force;
+    };
+    for (const bool warm : {false, true}) {
+      Matrix3Xd qf, qr;
+      if (warm) {  // the guess: the load of a nearby state, as the previous stage's
+        const Matrix3Xd R0 = force(x0);
+        full.compute_load(x0, R0, qf);
+        reduced.compute_load_symmetric(x0, R0, qr, false, mirror, central);
+      }
+      const Matrix3Xd R = force(x1);
+      full.compute_load(x1, R, qf, warm);
+      const int full_iterations = full.last_iterations();
+      reduced.compute_load_symmetric(x1, R, qr, warm, mirror, central);
+      const double scale = qf.cwiseAbs().maxCoeff();
+      const double diff = (qr - qf).cwiseAbs().maxCoeff() / scale;
+      std::printf("  %s%s, %s: reduced vs full load, max diff / max |q| = %.2e (CG iterations %d and %d)\n",
+                  mirror ? "mirror " : "", central ? "central" : "", warm ? "warm" : "cold", diff,
+                  reduced.last_iterations(), full_iterations);
+      // Both stop at |R − M q| ≤ tol |R|; the load error is about the residual times the condition number (≈ 10).
+      EXPECT_LT(diff, 1e3 * tol);
+      EXPECT_GT(reduced.last_iterations(), 0);
+      for (int i = 0; i < m.num_nodes(); ++i) {
+        if (central)
+          for (int c = 0; c < 3; ++c) ASSERT_EQ(qr(c, m.central_node[i]), -qr(c, i));
+        if (mirror) {
+          const int j = m.mirror_node[i];
+          ASSERT_EQ(qr(0, j), qr(0, i));
+          ASSERT_EQ(qr(1, j), qr(1, i));
+          ASSERT_EQ(qr(2, j), -qr(2, i));
+          if (j == i) ASSERT_EQ(qr(2, i), 0.0);
+        }
+      }
+      // The reduced solution meets the full residual test: |R − M q| ≤ tol |R| per component (M of x1).
+      const Matrix3Xd res = R - qr * full.mass_matrix();
+      for (int c = 0; c < 3; ++c) EXPECT_LE(res.row(c).norm(), 1.01 * tol * R.row(c).norm()) << "component " << c;
+    }
   }
 }
 

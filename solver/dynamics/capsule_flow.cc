@@ -66,16 +66,15 @@ void CapsuleFlow::set_second_kind_solve(std::unique_ptr<SecondKindSolve> solve) 
 
 membrane::MembraneState CapsuleFlow::elastic_force(const Eigen::Matrix3Xd& x, LoadSymmetry& symmetry) {
   const auto t0 = std::chrono::steady_clock::now();
-  // With numerics.central_symmetry and a centrally symmetric x (to the boundary integral's position tolerance),
-  // half the elements, the others their images (MembraneMechanics::evaluate_centrally_symmetric). The load is
-  // then solved for one node of each orbit of the symmetries x has (LoadSolver::compute_load_symmetric): the
-  // mirror x3 → −x3, which the boundary integral uses whenever x and q have it (unless its symmetry is Off), and
-  // the point reflection with numerics.central_symmetry.
+  // The symmetries x has (to the boundary integral's position tolerance) and the case uses: the mirror x3 → −x3,
+  // which the boundary integral uses whenever x and q have it (unless its symmetry is Off), and the point
+  // reflection with numerics.central_symmetry. The forces are computed on one element of each orbit of their
+  // group (MembraneMechanics::evaluate_symmetric) and the load solved for one node of each orbit
+  // (LoadSolver::compute_load_symmetric).
   const stokes::SingleLayerOptions& so = single_layer_->options();
   symmetry.central = so.central_symmetry && mesh::is_centrally_symmetric(*mesh_, x, so.symmetry_tol);
   symmetry.mirror = so.symmetry != stokes::Symmetry::Off && mesh::is_mirror_symmetric(*mesh_, x, so.symmetry_tol);
-  membrane::MembraneState s = symmetry.central ? mechanics_->evaluate_centrally_symmetric(x, /*with_energy=*/false)
-                                               : mechanics_->evaluate(x, /*with_energy=*/false);
+  membrane::MembraneState s = mechanics_->evaluate_symmetric(x, /*with_energy=*/false, symmetry.mirror, symmetry.central);
   timings_.membrane_s += seconds_since(t0);
   return s;
 }

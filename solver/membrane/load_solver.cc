@@ -64,8 +64,6 @@ LoadSolver::LoadSolver(const mesh::SurfaceMesh& mesh, Options options)
   if (options_.backend == Backend::Cholmod) {
     impl_->cholmod.analyzePattern(M_);
     if (impl_->cholmod.info() != Eigen::Success) throw std::runtime_error("CHOLMOD: symbolic analysis failed");
-  } else {
-    central_ = mesh::central_elements(mesh);
   }
 }
 
@@ -73,7 +71,7 @@ LoadSolver::~LoadSolver() = default;
 
 void LoadSolver::assemble(const Eigen::Matrix3Xd& x) { assemble_elements(x, nullptr); }
 
-void LoadSolver::assemble_elements(const Eigen::Matrix3Xd& x, const std::vector<int>* elements) {
+void LoadSolver::assemble_elements(const Eigen::Matrix3Xd& x, const mesh::ElementOrbits* orbits) {
   if (x.cols() != mesh_.num_nodes()) throw std::invalid_argument("LoadSolver: positions do not match the mesh");
   double* val = M_.valuePtr();
   std::fill(val, val + M_.nonZeros(), 0.0);
@@ -83,8 +81,8 @@ void LoadSolver::assemble_elements(const Eigen::Matrix3Xd& x, const std::vector<
   // same order as a serial loop, for any thread count.
   std::vector<double>& local = impl_->local;
   local.assign(static_cast<std::size_t>(ne) * 36, 0.0);
-  const int count = elements ? static_cast<int>(elements->size()) : ne;
-  const int* which = elements ? elements->data() : nullptr;
+  const int count = orbits ? static_cast<int>(orbits->representatives.size()) : ne;
+  const int* which = orbits ? orbits->representatives.data() : nullptr;
 #pragma omp parallel for schedule(static)
   for (int k = 0; k < count; ++k) {
     const int e = which ? which[k] : k;
@@ -107,15 +105,14 @@ void LoadSolver::assemble_elements(const Eigen::Matrix3Xd& x, const std::vector<
     for (int i = 0; i < 6; ++i)
       for (int j = 0; j < i; ++j) le[i * 6 + j] = le[j * 6 + i];
   }
-  if (which) {
-    // The mass matrix is even under x → −x: an image element's is the element's, its nodes permuted.
-    for (int k = 0; k < count; ++k) {
-      const int e = which[k], p = central_.image[e];
-      const double* from = local.data() + static_cast<std::size_t>(e) * 36;
-      double* to = local.data() + static_cast<std::size_t>(p) * 36;
-      const auto& pi = central_.local[e];
+  if (orbits) {
+    // The mass matrix is invariant under the symmetries: an image element's is its representative's, its nodes
+    // permuted.
+    for (const mesh::ElementOrbits::Image& im : orbits->images) {
+      const double* from = local.data() + static_cast<std::size_t>(im.from) * 36;
+      double* to = local.data() + static_cast<std::size_t>(im.element) * 36;
       for (int i = 0; i < 6; ++i)
-        for (int j = 0; j < 6; ++j) to[pi[i] * 6 + pi[j]] = from[i * 6 + j];
+        for (int j = 0; j < 6; ++j) to[im.local[i] * 6 + im.local[j]] = from[i * 6 + j];
     }
   }
   for (int e = 0; e < ne; ++e) {
@@ -369,6 +366,7 @@ LoadSolver::Reduction LoadSolver::build_reduction(bool mirror, bool central) con
   // Orbits, each represented by its smallest node; the sign of every node relative to its representative per
   // group element that maps the representative onto it.
   Reduction red;
+  red.elements = mesh::element_orbits(mesh_, mirror, central);
   red.orbit_of.assign(static_cast<std::size_t>(n), -1);
   std::vector<int> orbit_size, stabiliser_flips;  // per orbit: size; bit c set: some g fixing the rep flips c
   std::vector<std::array<double, 3>> node_sign(static_cast<std::size_t>(n));
@@ -504,15 +502,15 @@ void LoadSolver::solve_class(Reduction::Class& cl, const Reduction& red, const E
 void LoadSolver::compute_load_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q,
                                         bool warm, bool mirror, bool central) {
   const bool have_mirror = mirror && static_cast<int>(mesh_.mirror_node.size()) == mesh_.num_nodes();
-  const bool have_central = central && !central_.empty();
+  const bool have_central = central && static_cast<int>(mesh_.central_node.size()) == mesh_.num_nodes();
   if (options_.backend != Backend::ConjugateGradient || !(have_mirror || have_central))
     return compute_load(x, R, q, warm);
   // Phases: assemble M (from half the elements under x → −x, the others their images); the reduced right side
   // (R, or for the warm start R − M q0, at the representatives); per class of components, A', CG and the loads.
-  assemble_elements(x, have_central ? &central_.half : nullptr);
   const int index = (have_mirror ? 1 : 0) + (have_central ? 2 : 0) - 1;
   if (!reductions_[index]) reductions_[index] = std::make_unique<Reduction>(build_reduction(have_mirror, have_central));
   Reduction& red = *reductions_[index];
+  assemble_elements(x, red.elements.empty() ? nullptr : &red.elements);
   Impl& w = *impl_;
   const int n = mesh_.num_nodes();
   const bool from_guess = warm && q.rows() == 3 && q.cols() == R.cols();

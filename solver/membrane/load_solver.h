@@ -66,8 +66,8 @@ class LoadSolver {
   /// (W = diag(|O|/|G|)): A' = W^{−1/2} Bᵀ M B W^{−1/2} / |G|, b' = W^{−1/2} Bᵀ R / |G| = sqrt(|O|/|G|) R_r. A' is SPD,
   /// and |b' − A' q'|² = |R − M q|² / |G| for equivariant fields, so the CG's relative residual test is the full
   /// solve's. Components with the same signs under every group element share one A' (mirror: q1, q2 | q3; x → −x:
-  /// all three; both: q1, q2 | q3) and are solved side by side. Element mass matrices are computed for half the
-  /// elements under x → −x (an element's is its image's, permuted). One unknown per orbit: half the unknowns
+  /// all three; both: q1, q2 | q3) and are solved side by side. Element mass matrices are computed for one element
+  /// of each orbit (mesh::element_orbits; an image's is its representative's, permuted). One unknown per orbit: half the unknowns
   /// with one symmetry, a quarter with both. q agrees with compute_load's to the CG tolerance and is exactly
   /// equivariant. CG backend only; otherwise, or without the maps the symmetries need, it is compute_load.
   void compute_load_symmetric(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& R, Eigen::Matrix3Xd& q, bool warm,
@@ -100,6 +100,7 @@ class LoadSolver {
     std::vector<int> orbit_of;                       // node → orbit
     std::vector<std::array<double, 3>> node_sign;    // node → S_g of the g mapping its representative onto it
     std::vector<Class> classes;
+    mesh::ElementOrbits elements;                    // the elements under the group (assembly on representatives)
   };
   Reduction build_reduction(bool mirror, bool central) const;
   template <int K>
@@ -111,14 +112,13 @@ class LoadSolver {
   template <int K>
   void solve_cg(const Eigen::SparseMatrix<double>& A, const std::vector<double>& inv_diag, const double* b, int n,
                 double* x, const double* reference2 = nullptr);
-  // Element mass matrices (of `elements`, all when null, the others as their images), summed into M.
-  void assemble_elements(const Eigen::Matrix3Xd& x, const std::vector<int>* elements);
+  // Element mass matrices (every element, or the representatives of `orbits` and their images), summed into M.
+  void assemble_elements(const Eigen::Matrix3Xd& x, const mesh::ElementOrbits* orbits);
   struct Impl;
   const mesh::SurfaceMesh& mesh_;
   Options options_;
   Eigen::SparseMatrix<double> M_;
   std::vector<int> value_index_;  // element-major 6×6 → position in M_.valuePtr()
-  mesh::CentralElements central_;  // x → −x on elements (empty: no map)
   std::unique_ptr<Reduction> reductions_[3];  // mirror, x → −x, both
   std::unique_ptr<Impl> impl_;
   int last_iterations_ = 0;

@@ -50,7 +50,7 @@ MembraneMechanics::MembraneMechanics(const mesh::SurfaceMesh& mesh, const Eigen:
                                   " of the reference surface is degenerate");
   }
   // The elements' images under x → −x, for evaluate_centrally_symmetric.
-  central_ = mesh::central_elements(mesh);
+  for (int g = 0; g < 3; ++g) orbits_[g] = mesh::element_orbits(mesh, g != 1, g != 0);  // mirror, x → −x, both
 }
 
 namespace {
@@ -119,11 +119,17 @@ MembraneState MembraneMechanics::evaluate(const Eigen::Matrix3Xd& x, bool with_e
 }
 
 MembraneState MembraneMechanics::evaluate_centrally_symmetric(const Eigen::Matrix3Xd& x, bool with_energy) const {
-  return evaluate_elements(x, with_energy, central_.empty() ? nullptr : &central_.half);
+  return evaluate_symmetric(x, with_energy, false, true);
+}
+
+MembraneState MembraneMechanics::evaluate_symmetric(const Eigen::Matrix3Xd& x, bool with_energy, bool mirror,
+                                                    bool central) const {
+  const mesh::ElementOrbits* orbits = (mirror || central) ? &orbits_[(mirror ? 1 : 0) + (central ? 2 : 0) - 1] : nullptr;
+  return evaluate_elements(x, with_energy, orbits && !orbits->empty() ? orbits : nullptr);
 }
 
 MembraneState MembraneMechanics::evaluate_elements(const Eigen::Matrix3Xd& x, bool with_energy,
-                                                   const std::vector<int>* elements) const {
+                                                   const mesh::ElementOrbits* orbits) const {
   // Two phases, so that the result is bitwise the same for any thread count: (1) in parallel over elements,
   // each element's forces on its six nodes, energy and tension extremes into its own slot; (2) serially in
   // element order, the sums over elements. Per-call buffers keep evaluate() const and thread-safe.
@@ -131,8 +137,8 @@ MembraneState MembraneMechanics::evaluate_elements(const Eigen::Matrix3Xd& x, bo
   std::vector<double> force(static_cast<std::size_t>(ne) * 18), energy(static_cast<std::size_t>(ne)),
       lo(static_cast<std::size_t>(ne)), hi(static_cast<std::size_t>(ne));
   int first_collapsed = ne;
-  const int count = elements ? static_cast<int>(elements->size()) : ne;
-  const int* which = elements ? elements->data() : nullptr;
+  const int count = orbits ? static_cast<int>(orbits->representatives.size()) : ne;
+  const int* which = orbits ? orbits->representatives.data() : nullptr;
 #pragma omp parallel for schedule(static) reduction(min : first_collapsed)
   for (int k = 0; k < count; ++k) {
     const int e = which ? which[k] : k;
@@ -174,18 +180,17 @@ MembraneState MembraneMechanics::evaluate_elements(const Eigen::Matrix3Xd& x, bo
     hi[e] = tmax;
   }
   if (first_collapsed < ne) collapsed(first_collapsed);  // the lowest such element, as a serial loop would
-  if (which) {
-    // The image of each evaluated element: R is odd under x → −x, so its forces are the negated ones on the
-    // image nodes; energy and tension extremes are the same.
-    for (int k = 0; k < count; ++k) {
-      const int e = which[k], p = central_.image[e];
-      const double* from = force.data() + static_cast<std::size_t>(e) * 18;
-      double* to = force.data() + static_cast<std::size_t>(p) * 18;
+  if (orbits) {
+    // The images of the evaluated elements: R is equivariant (R_g(i) = S_g R_i), so an image's forces are its
+    // representative's with the group element's signs, on the image nodes; energy and tension extremes are the same.
+    for (const mesh::ElementOrbits::Image& im : orbits->images) {
+      const double* from = force.data() + static_cast<std::size_t>(im.from) * 18;
+      double* to = force.data() + static_cast<std::size_t>(im.element) * 18;
       for (int a = 0; a < 6; ++a)
-        for (int c = 0; c < 3; ++c) to[3 * central_.local[e][a] + c] = -from[3 * a + c];
-      energy[p] = energy[e];
-      lo[p] = lo[e];
-      hi[p] = hi[e];
+        for (int c = 0; c < 3; ++c) to[3 * im.local[a] + c] = im.sign[c] * from[3 * a + c];
+      energy[im.element] = energy[im.from];
+      lo[im.element] = lo[im.from];
+      hi[im.element] = hi[im.from];
     }
   }
   MembraneState s;

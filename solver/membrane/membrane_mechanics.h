@@ -58,15 +58,18 @@ class MembraneMechanics {
   /// @throws DegenerateSurface if an element is flipped or collapsed.
   [[nodiscard]] MembraneState evaluate(const Eigen::Matrix3Xd& x, bool with_energy = true) const;
 
-  /// @brief The same, for positions x centrally symmetric (x_P(i) = −x_i, mesh.central_node) to round-off: each
-  /// pair of image elements {e, P(e)} is evaluated once and the image gets the negated forces on the image
-  /// nodes (the internal force R is odd under x → −x, the tensions and energy are even), half the work. Only
-  /// for such x (the caller checks: CapsuleFlow with numerics.central_symmetry); falls back to evaluate() if
-  /// the mesh has no central map. Forces agree with evaluate() to round-off, not bitwise.
+  /// @brief The same, for positions x symmetric under the mirror x3 → −x3 and/or the point reflection x → −x (to
+  /// round-off): one element of each orbit of the group (mesh::element_orbits) is evaluated and its images get its
+  /// forces with the group element's signs on the image nodes (R is equivariant, the tensions and energy are
+  /// invariant): half the work with one symmetry, a quarter with both. Only for such x (the caller checks:
+  /// CapsuleFlow); evaluate() if the mesh lacks the maps. Forces agree with evaluate() to round-off, not bitwise.
+  [[nodiscard]] MembraneState evaluate_symmetric(const Eigen::Matrix3Xd& x, bool with_energy, bool mirror,
+                                                 bool central) const;
+  /// @brief evaluate_symmetric with the point reflection alone (numerics.central_symmetry).
   [[nodiscard]] MembraneState evaluate_centrally_symmetric(const Eigen::Matrix3Xd& x, bool with_energy = true) const;
   /// @brief Whether evaluate_centrally_symmetric can use the symmetry (the mesh has a central map that maps
   /// elements onto elements).
-  [[nodiscard]] bool has_central_map() const { return !central_.empty(); }
+  [[nodiscard]] bool has_central_map() const { return !orbits_[1].empty(); }
 
   /// @brief Elastic energy W only (for finite-difference checks).
   [[nodiscard]] double energy(const Eigen::Matrix3Xd& x) const;
@@ -87,14 +90,14 @@ class MembraneMechanics {
   };
   template <class Visit>
   void for_each_point(const Eigen::Matrix3Xd& x, Visit&& visit) const;
-  // Both evaluations: the elements in `elements` (all when null) and, when given, their images from the central map.
-  MembraneState evaluate_elements(const Eigen::Matrix3Xd& x, bool with_energy, const std::vector<int>* elements) const;
+  // Both evaluations: every element (orbits null), or the representatives of `orbits` and their images.
+  MembraneState evaluate_elements(const Eigen::Matrix3Xd& x, bool with_energy, const mesh::ElementOrbits* orbits) const;
 
   const mesh::SurfaceMesh& mesh_;
   const MembraneLaw& law_;
   mesh::P2Tabulation p2_;                                  // the rule's points
   std::vector<RefPoint> ref_;                              // element-major, per rule point
-  mesh::CentralElements central_;                         // x → −x on elements (empty if the mesh has no map)
+  mesh::ElementOrbits orbits_[3];                          // elements under the mirror, x → −x, both (empty: no map)
 };
 
 /// @brief Surface area ∫_S dS and enclosed volume (1/3)∫_S x·n dS of positions x on the exact P2 geometry.

@@ -406,10 +406,26 @@ bool is_mirror_symmetric(const SurfaceMesh& m, const Eigen::Matrix3Xd& x, double
   return x.cols() > 0 && symmetric_under(m.mirror_node, kMirrorSigns, x, relative_to_extent(x, tol));
 }
 
-CentralElements central_elements(const SurfaceMesh& m) {
-  CentralElements out;
-  const int ne = m.num_elements();
-  if (static_cast<int>(m.central_node.size()) != m.num_nodes() || ne == 0) return out;
+ElementOrbits element_orbits(const SurfaceMesh& m, bool mirror, bool central) {
+  ElementOrbits out;
+  const int ne = m.num_elements(), n = m.num_nodes();
+  if (ne == 0 || (!mirror && !central)) return out;
+  if ((mirror && static_cast<int>(m.mirror_node.size()) != n) || (central && static_cast<int>(m.central_node.size()) != n))
+    return out;
+  // The group's non-identity elements as node maps with their signs.
+  struct Element {
+    std::vector<int> map;
+    std::array<double, 3> sign;
+  };
+  std::vector<Element> group;
+  if (mirror) group.push_back({m.mirror_node, kMirrorSigns});
+  if (central) group.push_back({m.central_node, kCentralSigns});
+  if (mirror && central) {
+    Element h{std::vector<int>(static_cast<std::size_t>(n)), {}};
+    for (int i = 0; i < n; ++i) h.map[i] = m.central_node[m.mirror_node[i]];
+    for (int c = 0; c < 3; ++c) h.sign[c] = kMirrorSigns[c] * kCentralSigns[c];
+    group.push_back(std::move(h));
+  }
   // Elements are found by their node sets.
   std::map<std::array<int, 6>, int> by_nodes;
   for (int e = 0; e < ne; ++e) {
@@ -417,23 +433,30 @@ CentralElements central_elements(const SurfaceMesh& m) {
     std::sort(key.begin(), key.end());
     by_nodes.emplace(key, e);
   }
-  std::vector<int> image(static_cast<std::size_t>(ne), -1);
-  std::vector<std::array<int, 6>> local(static_cast<std::size_t>(ne));
+  std::vector<char> done(static_cast<std::size_t>(ne), 0);
   for (int e = 0; e < ne; ++e) {
-    std::array<int, 6> key{};
-    for (int a = 0; a < 6; ++a) key[a] = m.central_node[m.elements[e][a]];
-    std::sort(key.begin(), key.end());
-    const auto it = by_nodes.find(key);
-    if (it == by_nodes.end() || it->second == e) return out;
-    image[e] = it->second;
-    const auto& to = m.elements[it->second];
-    for (int a = 0; a < 6; ++a)
-      local[e][a] = static_cast<int>(std::find(to.begin(), to.end(), m.central_node[m.elements[e][a]]) - to.begin());
+    if (done[e]) continue;
+    done[e] = 1;
+    out.representatives.push_back(e);
+    for (const Element& g : group) {
+      std::array<int, 6> key{};
+      for (int a = 0; a < 6; ++a) key[a] = g.map[m.elements[e][a]];
+      std::sort(key.begin(), key.end());
+      const auto it = by_nodes.find(key);
+      if (it == by_nodes.end()) return ElementOrbits{};  // the map does not map elements onto elements
+      const int p = it->second;
+      if (done[p]) continue;  // e itself (an element across the mirror plane), or an image already listed
+      done[p] = 1;
+      ElementOrbits::Image im;
+      im.element = p;
+      im.from = e;
+      im.sign = g.sign;
+      const auto& to = m.elements[p];
+      for (int a = 0; a < 6; ++a)
+        im.local[a] = static_cast<int>(std::find(to.begin(), to.end(), g.map[m.elements[e][a]]) - to.begin());
+      out.images.push_back(im);
+    }
   }
-  out.image = std::move(image);
-  out.local = std::move(local);
-  for (int e = 0; e < ne; ++e)
-    if (e < out.image[e]) out.half.push_back(e);
   return out;
 }
 

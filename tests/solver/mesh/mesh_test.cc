@@ -112,6 +112,44 @@ TEST(SphereMesh, CentralImagesAreNegatedNodesAndElements) {
   }
 }
 
+// The element orbits under the mirror, the point reflection and both: every element is a representative or the
+// image of one exactly once, each image is its representative's nodes mapped by the group element (local
+// permutation included), and the orbits have the group's size except for the elements across the mirror plane,
+// which are their own mirror images (so a quarter of the elements, plus those, are evaluated with both).
+TEST(CapsuleMesh, ElementOrbitsCoverEveryElementOnce) {
+  const SurfaceMesh m = make_capsule_mesh(3, 2.0);
+  for (const auto& [mirror, central] : {std::pair{true, false}, std::pair{false, true}, std::pair{true, true}}) {
+    const ElementOrbits o = element_orbits(m, mirror, central);
+    ASSERT_FALSE(o.empty());
+    std::vector<int> seen(static_cast<std::size_t>(m.num_elements()), 0);
+    for (int e : o.representatives) ++seen[e];
+    for (const ElementOrbits::Image& im : o.images) {
+      ++seen[im.element];
+      EXPECT_LT(im.from, im.element);  // the representative is the orbit's smallest element
+      const bool is_mirror = im.sign == kMirrorSigns, is_central = im.sign == kCentralSigns;
+      for (int a = 0; a < 6; ++a) {
+        const int i = m.elements[im.from][a];
+        const int expected = is_mirror ? m.mirror_node[i] : is_central ? m.central_node[i] : m.central_node[m.mirror_node[i]];
+        EXPECT_EQ(m.elements[im.element][im.local[a]], expected);
+      }
+    }
+    for (int e = 0; e < m.num_elements(); ++e) EXPECT_EQ(seen[e], 1) << e;
+    const int group = (mirror ? 2 : 1) * (central ? 2 : 1);
+    // Orbits of full size, except the elements across the plane (their own mirror images: 32 at level 3).
+    const int across = static_cast<int>(o.representatives.size()) * group - m.num_elements();
+    std::printf("  mirror %d central %d: %zu representatives of %d elements\n", mirror, central,
+                o.representatives.size(), m.num_elements());
+    if (!mirror) EXPECT_EQ(across, 0);
+    if (mirror) EXPECT_GT(across, 0);
+    EXPECT_LT(across, m.num_elements() / 10);
+  }
+  SurfaceMesh no_map = m;
+  no_map.mirror_node.clear();
+  EXPECT_TRUE(element_orbits(no_map, true, false).empty());
+  EXPECT_TRUE(element_orbits(no_map, true, true).empty());
+  EXPECT_FALSE(element_orbits(no_map, false, true).empty());
+}
+
 INSTANTIATE_TEST_SUITE_P(AspectRatios, CapsuleMeshMaps,
                          ::testing::Combine(::testing::Values(0.5, 2.0),
                                             ::testing::Values(SpheroidMap::AxisScaling, SpheroidMap::EqualArcLength,

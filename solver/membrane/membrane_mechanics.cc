@@ -49,7 +49,7 @@ MembraneMechanics::MembraneMechanics(const mesh::SurfaceMesh& mesh, const Eigen:
       throw std::invalid_argument("membrane: element " + std::to_string(i / nq) +
                                   " of the reference surface is degenerate");
   }
-  // The elements' images under x → −x, for evaluate_centrally_symmetric.
+  // The elements under the mirror, x → −x and both, for evaluate_symmetric.
   for (int g = 0; g < 3; ++g) orbits_[g] = mesh::element_orbits(mesh, g != 1, g != 0);  // mirror, x → −x, both
 }
 

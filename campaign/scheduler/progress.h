@@ -130,7 +130,8 @@ class EtaModel {
   static constexpr double kCarryWeight = 4.0;
   /// @brief A case's wall time on the next finer level over its wall time on this one, divided by the cost
   /// model's ratio of its two estimates: 0.84, the geometric mean over the 115 cases run on both levels 2 and 3
-  /// (same cell, Ca and time step) of the committed databases — 0.85 over 29 in results/table1/table1_mf_mixed.sqlite,
+  /// (same cell, Ca and time step) of the committed databases — 0.85 over 29 in the main command's version-2 run
+  /// (tests/campaign/store/fixtures/table1_mf_mixed_v2.sqlite; its version-3 rerun in results/table1/ gives 0.92),
   /// 0.97 over 29 in results/table1_certified/table1_certified.sqlite, 0.78 over 57 in
   /// results/bending/table1_bending.sqlite (EtaModel.TheCostModelCarriesACaseAcrossLevels redoes it). Two parts:
   /// the finer level's cases stop sooner (their periods repeat sooner; a multi-fidelity case waits for one answer

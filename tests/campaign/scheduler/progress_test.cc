@@ -20,8 +20,11 @@
 namespace capsim::campaign {
 namespace {
 
-// The main command's committed run (scripts/run, campaign/presets/table1_mf_mixed.toml).
-constexpr const char* kMainCommandDb = "results/table1/table1_mf_mixed.sqlite";
+// The main command's run the ETA model was calibrated on (scripts/run, campaign/presets/table1_mf_mixed.toml,
+// 595ec9b, solver version 2), kept as a fixture since results/table1/ holds the version-3 rerun. The rerun's replay
+// (campaign/README.md, "Progress") is within ±30 % up to 93 % done and +48 % at 94 %, where a bisection round added
+// near the end (one more case than the version-2 run) was not foreseen; the carry over its twins is 0.92.
+constexpr const char* kMainCommandDb = "tests/campaign/store/fixtures/table1_mf_mixed_v2.sqlite";
 
 TEST(EtaModel, UnknownBeforeAnyCaseFinished) {
   EtaModel m;
@@ -293,7 +296,7 @@ TEST(CellTally, CountsRoundsAndCasesPerCell) {
 TEST(EtaModel, TheCostModelCarriesACaseAcrossLevels) {
   double pooled = 0;
   int pooled_n = 0;
-  for (const char* name : {"results/table1/table1_mf_mixed.sqlite", "results/table1_certified/table1_certified.sqlite",
+  for (const char* name : {kMainCommandDb, "results/table1_certified/table1_certified.sqlite",
                            "results/bending/table1_bending.sqlite"}) {
     auto store = Store::open_readonly(std::string(CAPSIM_SOURCE_DIR) + "/" + name);
     Stmt s(store->db(), "SELECT c.params_json, r.wall_s, r.t_final FROM cases c JOIN results r ON r.case_id=c.case_id");

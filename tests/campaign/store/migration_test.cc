@@ -119,8 +119,9 @@ TEST(Migration, AnalysedVersion2DatabaseGainsTheRegimeTransition) {
 }
 
 TEST(Migration, Version6DatabaseMigratesToTheRegimeTransition) {
-  // The main command's committed database (schema 6), on a copy.
-  const fs::path committed = fs::path(CAPSIM_SOURCE_DIR) / "results" / "table1" / "table1_mf_mixed.sqlite";
+  // The main command's version-2 database (schema 6; the fixture kept when results/table1/ was re-run), on a copy.
+  const fs::path committed =
+      fs::path(CAPSIM_SOURCE_DIR) / "tests" / "campaign" / "store" / "fixtures" / "table1_mf_mixed_v2.sqlite";
   ASSERT_TRUE(fs::exists(committed)) << committed;
   const std::string dir = fresh_dir("migration_v6");
   const std::string db = dir + "/table1.sqlite";

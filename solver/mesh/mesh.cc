@@ -406,26 +406,28 @@ bool is_mirror_symmetric(const SurfaceMesh& m, const Eigen::Matrix3Xd& x, double
   return x.cols() > 0 && symmetric_under(m.mirror_node, kMirrorSigns, x, relative_to_extent(x, tol));
 }
 
-ElementOrbits element_orbits(const SurfaceMesh& m, bool mirror, bool central) {
-  ElementOrbits out;
-  const int ne = m.num_elements(), n = m.num_nodes();
-  if (ne == 0 || (!mirror && !central)) return out;
-  if ((mirror && static_cast<int>(m.mirror_node.size()) != n) || (central && static_cast<int>(m.central_node.size()) != n))
-    return out;
-  // The group's non-identity elements as node maps with their signs.
-  struct Element {
-    std::vector<int> map;
-    std::array<double, 3> sign;
-  };
-  std::vector<Element> group;
+std::vector<NodeSymmetry> symmetry_group(const SurfaceMesh& m, bool mirror, bool central) {
+  const int n = m.num_nodes();
+  if ((!mirror && !central) || (mirror && static_cast<int>(m.mirror_node.size()) != n) ||
+      (central && static_cast<int>(m.central_node.size()) != n))
+    return {};
+  std::vector<NodeSymmetry> group;
   if (mirror) group.push_back({m.mirror_node, kMirrorSigns});
   if (central) group.push_back({m.central_node, kCentralSigns});
   if (mirror && central) {
-    Element h{std::vector<int>(static_cast<std::size_t>(n)), {}};
+    NodeSymmetry h{std::vector<int>(static_cast<std::size_t>(n)), {}};
     for (int i = 0; i < n; ++i) h.map[i] = m.central_node[m.mirror_node[i]];
     for (int c = 0; c < 3; ++c) h.sign[c] = kMirrorSigns[c] * kCentralSigns[c];
     group.push_back(std::move(h));
   }
+  return group;
+}
+
+ElementOrbits element_orbits(const SurfaceMesh& m, bool mirror, bool central) {
+  ElementOrbits out;
+  const int ne = m.num_elements();
+  const std::vector<NodeSymmetry> group = symmetry_group(m, mirror, central);
+  if (ne == 0 || group.empty()) return out;
   // Elements are found by their node sets.
   std::map<std::array<int, 6>, int> by_nodes;
   for (int e = 0; e < ne; ++e) {
@@ -438,7 +440,7 @@ ElementOrbits element_orbits(const SurfaceMesh& m, bool mirror, bool central) {
     if (done[e]) continue;
     done[e] = 1;
     out.representatives.push_back(e);
-    for (const Element& g : group) {
+    for (const NodeSymmetry& g : group) {
       std::array<int, 6> key{};
       for (int a = 0; a < 6; ++a) key[a] = g.map[m.elements[e][a]];
       std::sort(key.begin(), key.end());

@@ -12,14 +12,18 @@
 namespace capsim::campaign::testing {
 namespace {
 
+// A copy of the committed fixture database `name` in a fresh scratch folder (the test must never write the fixture).
+std::string copy_of_fixture(const std::string& name, const std::string& scratch) {
+  const fs::path committed = fs::path(CAPSIM_SOURCE_DIR) / "tests" / "campaign" / "store" / "fixtures" / name;
+  EXPECT_TRUE(fs::exists(committed)) << committed;
+  const std::string db = fresh_dir(scratch) + "/" + name;
+  fs::copy_file(committed, db);
+  return db;
+}
+
 TEST(Migration, Version2DatabaseMigratesToGroupKeysAndKeepsTable1) {
   // The quick preset's campaign as it was first run (level 2, schema version 2), kept as the fixture.
-  const fs::path committed =
-      fs::path(CAPSIM_SOURCE_DIR) / "tests" / "campaign" / "store" / "fixtures" / "schema_v2_quick.sqlite";
-  ASSERT_TRUE(fs::exists(committed)) << committed;
-  const std::string dir = fresh_dir("migration_v2");
-  const std::string db = dir + "/quick.sqlite";
-  fs::copy_file(committed, db);
+  const std::string db = copy_of_fixture("schema_v2_quick.sqlite", "migration_v2");
   ASSERT_EQ(sql(db, "PRAGMA user_version"), "2\n") << "the committed database is the version-2 fixture";
   const std::string rows_before = sql(db, "SELECT count(*) FROM transitions");
   const auto table1 = [&] {
@@ -69,11 +73,7 @@ TEST(Migration, Version2DatabaseMigratesToGroupKeysAndKeepsTable1) {
 // transitions row holds the bracket between its largest tumbling and smallest swinging Ca, read back by the store
 // and printed by `query table1` (a third line per law in markdown, three fields in JSON) and `query transitions`.
 TEST(Migration, AnalysedVersion2DatabaseGainsTheRegimeTransition) {
-  const fs::path committed =
-      fs::path(CAPSIM_SOURCE_DIR) / "tests" / "campaign" / "store" / "fixtures" / "schema_v2_quick.sqlite";
-  const std::string dir = fresh_dir("migration_v2_regime");
-  const std::string db = dir + "/quick.sqlite";
-  fs::copy_file(committed, db);
+  const std::string db = copy_of_fixture("schema_v2_quick.sqlite", "migration_v2_regime");
   auto r = sh(exe() + " campaign analyse --db " + db);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(sql(db, "PRAGMA user_version"), std::to_string(Store::expected_schema_version()) + "\n");
@@ -120,12 +120,7 @@ TEST(Migration, AnalysedVersion2DatabaseGainsTheRegimeTransition) {
 
 TEST(Migration, Version6DatabaseMigratesToTheRegimeTransition) {
   // The main command's version-2 database (schema 6; the fixture kept when results/table1/ was re-run), on a copy.
-  const fs::path committed =
-      fs::path(CAPSIM_SOURCE_DIR) / "tests" / "campaign" / "store" / "fixtures" / "table1_mf_mixed_v2.sqlite";
-  ASSERT_TRUE(fs::exists(committed)) << committed;
-  const std::string dir = fresh_dir("migration_v6");
-  const std::string db = dir + "/table1.sqlite";
-  fs::copy_file(committed, db);
+  const std::string db = copy_of_fixture("table1_mf_mixed_v2.sqlite", "migration_v6");
   ASSERT_EQ(sql(db, "PRAGMA user_version"), "6\n") << "the committed database is of schema 6";
   const std::string rows_before = sql(db, "SELECT count(*) FROM transitions");
   const auto table1 = [&](const std::string& format) {
